@@ -1,0 +1,51 @@
+#include "coapt/fem/linear_solver.hpp"
+
+#include <fmt/format.h>
+
+#include "coapt/core/error.hpp"
+
+namespace coapt::fem {
+
+LinearSolver::LinearSolver(MPI_Comm comm, const std::string& prefix, const LinearSolverDefaults& defaults)
+    : prefix_(prefix) {
+  COAPT_PETSC_CHECK(KSPCreate(comm, ksp_.out()));
+  COAPT_PETSC_CHECK(KSPSetOptionsPrefix(ksp_, prefix.c_str()));
+  COAPT_PETSC_CHECK(KSPSetType(ksp_, defaults.ksp_type.c_str()));
+  PC pc = nullptr;
+  COAPT_PETSC_CHECK(KSPGetPC(ksp_, &pc));
+  COAPT_PETSC_CHECK(PCSetType(pc, defaults.pc_type.c_str()));
+  COAPT_PETSC_CHECK(KSPSetTolerances(ksp_, defaults.relative_tolerance, defaults.absolute_tolerance,
+                                     PETSC_DEFAULT, defaults.max_iterations));
+  COAPT_PETSC_CHECK(KSPSetFromOptions(ksp_));
+}
+
+void LinearSolver::set_operator(Mat matrix) {
+  COAPT_PETSC_CHECK(KSPSetOperators(ksp_, matrix, matrix));
+}
+
+SolveStats LinearSolver::solve(Vec rhs, Vec solution) {
+  COAPT_PETSC_CHECK(KSPSolve(ksp_, rhs, solution));
+  KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
+  PetscInt iterations = 0;
+  PetscReal residual = 0;
+  COAPT_PETSC_CHECK(KSPGetConvergedReason(ksp_, &reason));
+  COAPT_PETSC_CHECK(KSPGetIterationNumber(ksp_, &iterations));
+  COAPT_PETSC_CHECK(KSPGetResidualNorm(ksp_, &residual));
+  SolveStats stats{static_cast<int>(iterations), static_cast<double>(residual), KSPConvergedReasons[reason]};
+  if (reason < 0)
+    throw ConvergenceError(fmt::format("linear solver -{} did not converge: {} after {} iterations, residual norm {:.3e}",
+                                       prefix_, stats.reason, stats.iterations, stats.residual_norm));
+  return stats;
+}
+
+std::string LinearSolver::describe() const {
+  KSPType ksp_type = nullptr;
+  PCType pc_type = nullptr;
+  PC pc = nullptr;
+  KSPGetType(ksp_, &ksp_type);
+  KSPGetPC(ksp_, &pc);
+  PCGetType(pc, &pc_type);
+  return fmt::format("{} + {} (options prefix -{})", ksp_type ? ksp_type : "?", pc_type ? pc_type : "?", prefix_);
+}
+
+}  // namespace coapt::fem

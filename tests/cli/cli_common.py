@@ -1,0 +1,62 @@
+"""Shared helpers of the command-line tests: argument parsing, running coapt under mpirun,
+and small assertions with readable failures."""
+
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+
+def parse_arguments():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--coapt", required=True, help="the coapt executable")
+    parser.add_argument("--mpiexec", default="mpirun")
+    parser.add_argument("--source", required=True, help="the source tree (for cases/, tools/)")
+    parser.add_argument("--workdir", required=True, help="scratch folder for this test")
+    arguments = parser.parse_args()
+    work = Path(arguments.workdir)
+    shutil.rmtree(work, ignore_errors=True)
+    work.mkdir(parents=True)
+    return arguments
+
+
+class Runner:
+    """Runs coapt (optionally under mpirun) and keeps the output for messages."""
+
+    def __init__(self, arguments):
+        self.coapt = arguments.coapt
+        self.mpiexec = arguments.mpiexec
+        self.source = Path(arguments.source)
+        self.work = Path(arguments.workdir)
+        self.failures = 0
+        self.passed = 0
+
+    def run(self, *args, ranks=1, timeout=900, check=False):
+        command = [self.mpiexec, "--oversubscribe", "--bind-to", "none", "-np", str(ranks), self.coapt]
+        command += [str(a) for a in args]
+        environment = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+                           OMP_NUM_THREADS="1")
+        result = subprocess.run(command, capture_output=True, text=True, timeout=timeout, env=environment)
+        if check and result.returncode != 0:
+            raise AssertionError(f"{' '.join(command)} failed ({result.returncode}):\n{result.stdout}\n{result.stderr}")
+        return result
+
+    def expect(self, condition, what, detail=""):
+        if condition:
+            self.passed += 1
+            print(f"ok: {what}")
+        else:
+            self.failures += 1
+            print(f"FAILED: {what}\n{detail}")
+
+    def finish(self):
+        print(f"{self.passed} passed, {self.failures} failed")
+        sys.exit(1 if self.failures else 0)
+
+
+def read_json(path):
+    with open(path) as f:
+        return json.load(f)
