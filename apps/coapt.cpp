@@ -7,9 +7,9 @@
 //
 // Exit status: 0 success, 1 the run failed (solver, divergence), 2 bad input, 3 internal error.
 
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <CLI/CLI.hpp>
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -49,7 +49,9 @@ coapt::config::Document load_case(const Options& options) {
 std::string default_output(const std::string& case_file) {
   const auto path = std::filesystem::path(case_file);
   const auto parent = path.parent_path().filename().string();
-  return (std::filesystem::path("out") / ((parent.empty() ? "" : parent + "-") + path.stem().string())).string();
+  return (std::filesystem::path("out") /
+          ((parent.empty() ? "" : parent + "-") + path.stem().string()))
+      .string();
 }
 
 std::string command_line(int argc, char** argv) {
@@ -75,7 +77,8 @@ int keys(const Options& options, const coapt::Context& context) {
   coapt::log::info("| --- | --- | --- | --- | --- | --- |");
   for (const auto& key : document.keys())
     coapt::log::info("| `{}` | {} | {} | {} | {} | {} |", key.path, key.type,
-                     key.default_value.empty() ? "required" : "`" + key.default_value + "`", key.unit, key.range, key.doc);
+                     key.default_value.empty() ? "required" : "`" + key.default_value + "`",
+                     key.unit, key.range, key.doc);
   return 0;
 }
 
@@ -84,9 +87,10 @@ int mesh(const Options& options, const coapt::Context& context) {
   auto whole = coapt::mesh::read_gmsh(options.mesh_file);
   coapt::mesh::orient_cells(whole);
   const auto report = coapt::mesh::check_quality(whole);
-  coapt::log::info("{}: {}D, {} vertices, {} cells, {} tagged boundary facets", options.mesh_file, whole.dim,
-                   whole.n_vertices(), whole.n_cells(), whole.n_facets());
-  std::vector<double> lower(static_cast<std::size_t>(whole.dim), 1e300), upper(static_cast<std::size_t>(whole.dim), -1e300);
+  coapt::log::info("{}: {}D, {} vertices, {} cells, {} tagged boundary facets", options.mesh_file,
+                   whole.dim, whole.n_vertices(), whole.n_cells(), whole.n_facets());
+  std::vector<double> lower(static_cast<std::size_t>(whole.dim), 1e300),
+      upper(static_cast<std::size_t>(whole.dim), -1e300);
   for (int v = 0; v < whole.n_vertices(); ++v)
     for (int d = 0; d < whole.dim; ++d) {
       lower[d] = std::min(lower[d], whole.point(v)[d]);
@@ -95,35 +99,45 @@ int mesh(const Options& options, const coapt::Context& context) {
   coapt::log::info("bounding box: [{}] to [{}] m", fmt::join(lower, ", "), fmt::join(upper, ", "));
   for (const auto& group : whole.groups) {
     long count = 0;
-    if (group.dim == whole.dim) count = std::count(whole.cell_tags.begin(), whole.cell_tags.end(), group.tag);
-    if (group.dim == whole.dim - 1) count = std::count(whole.facet_tags.begin(), whole.facet_tags.end(), group.tag);
-    coapt::log::info("physical group '{}' (dimension {}, tag {}): {} elements", group.name, group.dim, group.tag, count);
+    if (group.dim == whole.dim)
+      count = std::count(whole.cell_tags.begin(), whole.cell_tags.end(), group.tag);
+    if (group.dim == whole.dim - 1)
+      count = std::count(whole.facet_tags.begin(), whole.facet_tags.end(), group.tag);
+    coapt::log::info("physical group '{}' (dimension {}, tag {}): {} elements", group.name,
+                     group.dim, group.tag, count);
   }
-  coapt::log::info("cell measure in [{:.4e}, {:.4e}] (total {:.6e}), shape quality (mean ratio, 1 = regular) in [{:.4f}, {:.4f}]",
-                   report.min_measure, report.max_measure, report.total_measure, report.min_shape, report.max_shape);
-  coapt::log::info("{} inverted and {} degenerate cells", report.inverted.size(), report.degenerate.size());
+  coapt::log::info(
+      "cell measure in [{:.4e}, {:.4e}] (total {:.6e}), shape quality (mean ratio, 1 = regular) in "
+      "[{:.4f}, {:.4f}]",
+      report.min_measure, report.max_measure, report.total_measure, report.min_shape,
+      report.max_shape);
+  coapt::log::info("{} inverted and {} degenerate cells", report.inverted.size(),
+                   report.degenerate.size());
   coapt::mesh::require_valid(whole, report);
   return 0;
 }
 
 int run(const Options& options, const coapt::Context& context, const std::string& command) {
-  const std::string directory = options.output.empty() ? default_output(options.case_file) : options.output;
+  const std::string directory =
+      options.output.empty() ? default_output(options.case_file) : options.output;
   std::unique_ptr<coapt::run::RunOutput> output;
   try {
     auto document = load_case(options);
     auto problem = coapt::run::create_problem(document.root(), context.comm());
     document.reject_unknown_keys();
-    output = std::make_unique<coapt::run::RunOutput>(context.comm(), directory, document.resolved_yaml(),
-                                                     options.case_file, command);
-    coapt::log::info("coapt {} on {} rank(s): {} -> {}", COAPT_VERSION, context.size(), options.case_file, directory);
+    output = std::make_unique<coapt::run::RunOutput>(
+        context.comm(), directory, document.resolved_yaml(), options.case_file, command);
+    coapt::log::info("coapt {} on {} rank(s): {} -> {}", COAPT_VERSION, context.size(),
+                     options.case_file, directory);
     problem->run(*output);
     const auto unused = coapt::Context::unused_petsc_options();
     if (!unused.empty()) {
       coapt::io::Json list = coapt::io::Json::array();
       for (const auto& option : unused) list.push_back(option);
       output->summary()["unused_petsc_options"] = list;
-      const std::string message = fmt::format("PETSc option(s) given but never used (misspelt or not for this case): {}",
-                                              fmt::join(unused, ", "));
+      const std::string message =
+          fmt::format("PETSc option(s) given but never used (misspelt or not for this case): {}",
+                      fmt::join(unused, ", "));
       if (options.strict_options) throw coapt::InputError(message);
       coapt::log::warn("warning: {}", message);
     }
@@ -134,7 +148,8 @@ int run(const Options& options, const coapt::Context& context, const std::string
     // Input errors before the folder exists leave no folder; later failures mark it failed.
     if (!output && !dynamic_cast<const coapt::InputError*>(&e)) {
       try {
-        output = std::make_unique<coapt::run::RunOutput>(context.comm(), directory, "", options.case_file, command);
+        output = std::make_unique<coapt::run::RunOutput>(context.comm(), directory, "",
+                                                         options.case_file, command);
       } catch (const coapt::Error&) {
       }
     }
@@ -160,20 +175,31 @@ int main(int argc, char** argv) {
   CLI::App app{"coapt: fluid-structure-contact interaction by an immersed domain method"};
   app.set_version_flag("--version", std::string("coapt ") + COAPT_VERSION);
   app.require_subcommand(1);
-  app.add_option("--log-level", options.log_level, "debug, info, warn or error")->check(CLI::IsMember({"debug", "info", "warn", "error"}));
-  auto* run_command = app.add_subcommand("run", "run a case: coapt run CASE.yaml [--output DIR] [--set k=v ...] [-- PETSc options]");
+  app.add_option("--log-level", options.log_level, "debug, info, warn or error")
+      ->check(CLI::IsMember({"debug", "info", "warn", "error"}));
+  auto* run_command = app.add_subcommand(
+      "run", "run a case: coapt run CASE.yaml [--output DIR] [--set k=v ...] [-- PETSc options]");
   run_command->add_option("case", options.case_file, "the case file (YAML)")->required();
-  run_command->add_option("--output,-o", options.output, "output folder (default: out/<case folder>-<case name>)");
-  run_command->add_option("--set", options.overrides, "override a key of the case: key.path=value (repeatable)");
-  run_command->add_flag("--strict-options", options.strict_options, "fail when a PETSc option is never used");
-  auto* check_command = app.add_subcommand("check", "validate a case and load its meshes; solves nothing");
+  run_command->add_option("--output,-o", options.output,
+                          "output folder (default: out/<case folder>-<case name>)");
+  run_command->add_option("--set", options.overrides,
+                          "override a key of the case: key.path=value (repeatable)");
+  run_command->add_flag("--strict-options", options.strict_options,
+                        "fail when a PETSc option is never used");
+  auto* check_command =
+      app.add_subcommand("check", "validate a case and load its meshes; solves nothing");
   check_command->add_option("case", options.case_file, "the case file (YAML)")->required();
-  check_command->add_option("--set", options.overrides, "override a key of the case: key.path=value (repeatable)");
-  auto* keys_command = app.add_subcommand("keys", "list the keys a case understands, with units and defaults");
+  check_command->add_option("--set", options.overrides,
+                            "override a key of the case: key.path=value (repeatable)");
+  auto* keys_command =
+      app.add_subcommand("keys", "list the keys a case understands, with units and defaults");
   keys_command->add_option("case", options.case_file, "the case file (YAML)")->required();
-  keys_command->add_option("--set", options.overrides, "override a key of the case: key.path=value (repeatable)");
-  auto* mesh_command = app.add_subcommand("mesh", "statistics, physical groups and quality of a Gmsh mesh");
-  mesh_command->add_option("file", options.mesh_file, "the mesh (.msh, version 2 or 4)")->required();
+  keys_command->add_option("--set", options.overrides,
+                           "override a key of the case: key.path=value (repeatable)");
+  auto* mesh_command =
+      app.add_subcommand("mesh", "statistics, physical groups and quality of a Gmsh mesh");
+  mesh_command->add_option("file", options.mesh_file, "the mesh (.msh, version 2 or 4)")
+      ->required();
   app.footer("PETSc options (solvers: -poisson_ksp_type, -fluid_pc_type, ...) go after '--'.");
 
   try {
@@ -188,15 +214,20 @@ int main(int argc, char** argv) {
     coapt::log::initialize(context.rank());
     coapt::log::set_level(options.log_level);
     try {
-      if (*run_command) status = run(options, context, command_line(argc, argv));
-      else if (*check_command) status = check(options, context);
-      else if (*keys_command) status = keys(options, context);
-      else if (*mesh_command) status = mesh(options, context);
+      if (*run_command)
+        status = run(options, context, command_line(argc, argv));
+      else if (*check_command)
+        status = check(options, context);
+      else if (*keys_command)
+        status = keys(options, context);
+      else if (*mesh_command)
+        status = mesh(options, context);
     } catch (const coapt::InputError& e) {
       if (context.rank() == 0) std::cerr << "coapt: error: " << e.what() << std::endl;
       status = kExitInput;
     } catch (const coapt::InternalError& e) {
-      if (context.rank() == 0) std::cerr << "coapt: internal error (please report): " << e.what() << std::endl;
+      if (context.rank() == 0)
+        std::cerr << "coapt: internal error (please report): " << e.what() << std::endl;
       status = kExitInternal;
     } catch (const coapt::Error& e) {
       if (context.rank() == 0) std::cerr << "coapt: run failed: " << e.what() << std::endl;

@@ -1,3 +1,55 @@
-int main() {
+// coapt-bench: coapt's benchmark program, one sub-command per measurement.
+//
+//   mpirun -np 2 coapt-bench assembly --n 64
+//
+// Each sub-command prints what it does and ends with one line holding a JSON object of the
+// figures (rates carry their unit in the key) and the peak memory per rank (peak_rss_mb).
+// Results go in bench/RESULTS.md with the date, the machine and the command.
+
+#include <sys/resource.h>
+
+#include <CLI/CLI.hpp>
+#include <iostream>
+#include <string>
+
+#include "bench_common.hpp"
+#include "coapt/core/context.hpp"
+#include "coapt/core/error.hpp"
+#include "coapt/core/log.hpp"
+
+int main(int argc, char** argv) {
+  std::vector<std::string> petsc_arguments;
+  int n_ours = argc;
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--") {
+      n_ours = i;
+      petsc_arguments.assign(argv + i + 1, argv + argc);
+      break;
+    }
+  CLI::App app{"coapt-bench: coapt's benchmarks"};
+  app.require_subcommand(1);
+  coapt::bench::AssemblyOptions assembly;
+  auto* assembly_command = app.add_subcommand(
+      "assembly", "P1 Laplacian and elasticity assembly on the unit cube (n^3 * 6 tets)");
+  assembly_command->add_option("--n", assembly.n, "cells per direction")->check(CLI::Range(1, 400));
+  assembly_command
+      ->add_option("--repeat", assembly.repeat, "re-assemblies timed (the mean is reported)")
+      ->check(CLI::Range(1, 1000));
+  try {
+    app.parse(n_ours, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  try {
+    coapt::Context context(petsc_arguments);
+    coapt::log::initialize(context.rank());
+    coapt::io::Json figures;
+    if (*assembly_command) figures = coapt::bench::assembly(context, assembly);
+    figures["peak_rss_mb"] = coapt::bench::peak_rss_mb(context.comm());
+    if (context.rank() == 0) std::cout << figures.dump(-1) << std::endl;
+  } catch (const coapt::Error& e) {
+    std::cerr << "coapt-bench: " << e.what() << std::endl;
+    return 1;
+  }
   return 0;
 }

@@ -49,7 +49,7 @@ def main():
     for ranks in (1, 3):
         expect_input_error("missing mesh file", ["run", missing_mesh, "--output", work / "o1"], ["nowhere.msh"], ranks=ranks)
 
-    good = meshes / "square_v41.msh"
+    good = meshes / "square_v2.msh"
     text = good.read_text()
     truncated = write(work / "truncated.msh", text[: len(text) // 2])
     expect_input_error("truncated mesh", ["mesh", truncated], ["truncated.msh"])
@@ -58,15 +58,15 @@ def main():
     case_truncated = write(work / "case_truncated.yaml", f"problem: poisson\nmesh:\n  type: gmsh\n  file: {truncated}\n")
     expect_input_error("truncated mesh in a case", ["check", case_truncated], ["truncated.msh"], ranks=2)
 
-    inverted = meshes / "inverted_tet_v2.msh"
-    expect_input_error("inverted element", ["mesh", inverted], ["inverted_tet_v2.msh", "inverted"])
+    inverted = meshes / "inverted_tet.msh"
+    expect_input_error("inverted element", ["mesh", inverted], ["inverted_tet.msh", "inverted"])
     case_inverted = write(work / "case_inverted.yaml", f"problem: poisson\nmesh:\n  type: gmsh\n  file: {inverted}\n")
-    expect_input_error("inverted element in a case", ["check", case_inverted], ["inverted_tet_v2.msh", "inverted"], ranks=2)
+    expect_input_error("inverted element in a case", ["check", case_inverted], ["inverted_tet.msh", "inverted"], ranks=2)
 
     missing_group = write(work / "missing_group.yaml",
                           f"problem: poisson\nmesh:\n  type: gmsh\n  file: {good}\ndirichlet: [left, inlet]\n")
     expect_input_error("physical group missing from the mesh", ["check", missing_group],
-                       ["missing_group.yaml:5", "dirichlet", "inlet", "square_v41.msh"])
+                       ["missing_group.yaml:5", "dirichlet", "inlet", "square_v2.msh"])
 
     result = r.run("frobnicate")
     r.expect(result.returncode != 0 and result.returncode < 128, "unknown sub-command -> non-zero exit", result.stderr)

@@ -15,7 +15,9 @@
 namespace coapt::config {
 namespace {
 
-std::string format_number(double value) { return fmt::format("{:g}", value); }
+std::string format_number(double value) {
+  return fmt::format("{:g}", value);
+}
 
 template <class T>
 std::string type_name() {
@@ -35,7 +37,8 @@ std::string to_text(const T& value) {
   if constexpr (std::is_same_v<T, std::string>) return value.empty() ? "\"\"" : value;
   if constexpr (std::is_same_v<T, std::vector<double>>) {
     std::string text = "[";
-    for (std::size_t i = 0; i < value.size(); ++i) text += (i ? ", " : "") + format_number(value[i]);
+    for (std::size_t i = 0; i < value.size(); ++i)
+      text += (i ? ", " : "") + format_number(value[i]);
     return text + "]";
   }
   if constexpr (std::is_same_v<T, std::vector<std::string>>) {
@@ -111,7 +114,9 @@ void Section::fail(std::string_view key, const std::string& message) const {
   throw InputError(fmt::format("{}: {}: {}", where(key), path.empty() ? "(case)" : path, message));
 }
 
-std::string Section::case_directory() const { return document_->directory(); }
+std::string Section::case_directory() const {
+  return document_->directory();
+}
 
 bool Section::has(std::string_view key) const {
   YAML::Node value = child(key);
@@ -135,7 +140,8 @@ T Section::convert(std::string_view key, const YAML::Node& value, const KeyInfo&
     if (!std::isfinite(number)) fail(key, "must be a finite number");
     if (!info.bounds.contains(number))
       fail(key, fmt::format("value {} is out of range: must be {}{}", format_number(number),
-                            info.bounds.describe(), info.unit.empty() ? "" : " " + std::string(info.unit)));
+                            info.bounds.describe(),
+                            info.unit.empty() ? "" : " " + std::string(info.unit)));
   };
   auto scalar_text = [&](const YAML::Node& node) -> std::string {
     if (!node.IsScalar()) fail(key, "expected a " + type_name<T>());
@@ -252,8 +258,8 @@ std::vector<Section> Section::sections(std::string_view key, std::string_view do
   return result;
 }
 
-#define COAPT_CONFIG_INSTANTIATE(T)                                                          \
-  template T Section::get<T>(std::string_view, const T&, const KeyInfo&) const;            \
+#define COAPT_CONFIG_INSTANTIATE(T)                                             \
+  template T Section::get<T>(std::string_view, const T&, const KeyInfo&) const; \
   template T Section::require<T>(std::string_view, const KeyInfo&) const;
 COAPT_CONFIG_INSTANTIATE(double)
 COAPT_CONFIG_INSTANTIATE(int)
@@ -297,7 +303,9 @@ std::string Document::directory() const {
   return parent.empty() ? "." : parent.string();
 }
 
-Section Document::root() { return Section(this, tree_, resolved_, ""); }
+Section Document::root() {
+  return Section(this, tree_, resolved_, "");
+}
 
 std::string Document::where(const YAML::Node& node, const std::string& path) const {
   for (const auto& [override_path, text] : overrides_)
@@ -338,7 +346,8 @@ void Document::set(const std::string& assignment) {
     walked += (walked.empty() ? "" : ".") + parts[i];
     const bool last = i + 1 == parts.size();
     if (!node.IsMap())
-      throw InputError("--set " + assignment + ": '" + walked + "' is inside a value, not a section");
+      throw InputError("--set " + assignment + ": '" + walked +
+                       "' is inside a value, not a section");
     if (match[2].matched) {
       const std::size_t index = std::stoul(match[3]);
       YAML::Node list = node[key];
@@ -368,15 +377,16 @@ void Document::reject_unknown_keys() const {
     for (const auto& entry : node) {
       const std::string key = entry.first.Scalar();
       const std::string child = path.empty() ? key : path + "." + key;
-      const bool known = used != used_.end() &&
-                         std::find(used->second.begin(), used->second.end(), key) != used->second.end();
+      const bool known = used != used_.end() && std::find(used->second.begin(), used->second.end(),
+                                                          key) != used->second.end();
       if (!known) {
         std::string hint;
         if (used != used_.end() && !used->second.empty()) {
           for (const auto& k : used->second) hint += (hint.empty() ? "" : ", ") + k;
           hint = " (keys here: " + hint + ")";
         }
-        throw InputError(fmt::format("{}: {}: unknown key{}", where(entry.first, child), child, hint));
+        throw InputError(
+            fmt::format("{}: {}: unknown key{}", where(entry.first, child), child, hint));
       }
       if (entry.second.IsMap() && used_.count(child)) self(self, entry.second, child);
       if (entry.second.IsSequence())

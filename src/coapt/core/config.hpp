@@ -28,7 +28,9 @@ struct Bounds {
 
   static Bounds any() { return {}; }
   static Bounds positive() { return {0.0, std::numeric_limits<double>::infinity(), true, false}; }
-  static Bounds non_negative() { return {0.0, std::numeric_limits<double>::infinity(), false, false}; }
+  static Bounds non_negative() {
+    return {0.0, std::numeric_limits<double>::infinity(), false, false};
+  }
   static Bounds closed(double lo, double hi) { return {lo, hi, false, false}; }
   static Bounds open(double lo, double hi) { return {lo, hi, true, true}; }
   bool contains(double value) const;
@@ -85,7 +87,9 @@ class Section {
  private:
   friend class Document;
   Section(Document* document, YAML::Node node, YAML::Node resolved, std::string path)
-      : document_(document), node_(std::move(node)), resolved_(std::move(resolved)),
+      : document_(document),
+        node_(std::move(node)),
+        resolved_(std::move(resolved)),
         path_(std::move(path)) {}
   std::string child_path(std::string_view key) const;
   YAML::Node child(std::string_view key) const;
@@ -95,7 +99,7 @@ class Section {
               const KeyInfo& info) const;
 
   Document* document_;
-  YAML::Node node_;      ///< the user's mapping (may be undefined)
+  YAML::Node node_;              ///< the user's mapping (may be undefined)
   mutable YAML::Node resolved_;  ///< the resolved mapping being built (a shared view)
   std::string path_;
 };
@@ -132,7 +136,7 @@ class Document {
   std::string name_;
   YAML::Node tree_;
   YAML::Node resolved_;
-  std::map<std::string, std::string> overrides_;            ///< path -> "--set ..." text
+  std::map<std::string, std::string> overrides_;          ///< path -> "--set ..." text
   std::map<std::string, std::vector<std::string>> used_;  ///< section path -> keys read
   std::vector<KeyRecord> records_;
 };

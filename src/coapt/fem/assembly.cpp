@@ -1,6 +1,7 @@
 #include "coapt/fem/assembly.hpp"
 
 #include <algorithm>
+#include <numeric>
 
 #include "coapt/core/error.hpp"
 
@@ -41,39 +42,89 @@ LocalValues::~LocalValues() {
 }
 
 P1Matrix::P1Matrix(const mesh::Mesh& mesh, int n_components)
-    : mesh_(mesh), n_components_(n_components), element_size_(mesh.vertices_per_cell() * n_components) {
-  const PetscInt n_local = static_cast<PetscInt>(mesh.n_owned_vertices) * n_components;
-  COAPT_PETSC_CHECK(MatCreate(mesh.comm, matrix_.out()));
-  COAPT_PETSC_CHECK(MatSetSizes(matrix_, n_local, n_local, PETSC_DETERMINE, PETSC_DETERMINE));
-  COAPT_PETSC_CHECK(MatSetType(matrix_, MATAIJ));
-  COAPT_PETSC_CHECK(MatSetBlockSize(matrix_, n_components));
-
-  // The COO pattern: every entry of every owned cell's element matrix, in element order.
-  const std::size_t block = static_cast<std::size_t>(element_size_) * element_size_;
-  const std::size_t n_entries = static_cast<std::size_t>(mesh.n_owned_cells) * block;
-  std::vector<PetscInt> rows(n_entries), columns(n_entries);
-  std::vector<PetscInt> dofs(static_cast<std::size_t>(element_size_));
-  const int k = mesh.vertices_per_cell();
-  for (int c = 0; c < mesh.n_owned_cells; ++c) {
-    const auto vertices = mesh.cell(c);
-    for (int a = 0; a < k; ++a)
-      for (int i = 0; i < n_components; ++i)
-        dofs[a * n_components + i] = mesh.global_vertex[vertices[a]] * n_components + i;
-    PetscInt* r = rows.data() + c * block;
-    PetscInt* s = columns.data() + c * block;
-    for (int p = 0; p < element_size_; ++p)
-      for (int q = 0; q < element_size_; ++q) {
-        r[p * element_size_ + q] = dofs[p];
-        s[p * element_size_ + q] = dofs[q];
+    : mesh_(mesh), n_components_(n_components) {
+  const int k = mesh.vertices_per_cell(), n_owned = mesh.n_owned_vertices, n = n_components;
+  // Local cells touching an owned vertex, and for each owned vertex the cells around it.
+  std::vector<int> cells_of_vertex_count(static_cast<std::size_t>(n_owned) + 1, 0);
+  for (int c = 0; c < mesh.n_cells(); ++c) {
+    bool touches = false;
+    for (int v : mesh.cell(c))
+      if (v < n_owned) {
+        touches = true;
+        ++cells_of_vertex_count[static_cast<std::size_t>(v) + 1];
       }
+    if (touches) cells_.push_back(c);
   }
-  COAPT_PETSC_CHECK(MatSetPreallocationCOO(matrix_, static_cast<PetscCount>(n_entries), rows.data(),
-                                           columns.data()));
-  values_.assign(n_entries, 0.0);
+  std::partial_sum(cells_of_vertex_count.begin(), cells_of_vertex_count.end(),
+                   cells_of_vertex_count.begin());
+  std::vector<int> cells_of_vertex(static_cast<std::size_t>(cells_of_vertex_count.back()));
+  {
+    std::vector<int> fill(cells_of_vertex_count.begin(), cells_of_vertex_count.end() - 1);
+    for (int c : cells_)
+      for (int v : mesh.cell(c))
+        if (v < n_owned) cells_of_vertex[fill[v]++] = c;
+  }
+  // Neighbours of each owned vertex (local indices), sorted by global number: the node pattern.
+  node_offsets_.assign(static_cast<std::size_t>(n_owned) + 1, 0);
+  std::vector<int> neighbours;
+  std::vector<int> buffer;
+  for (int v = 0; v < n_owned; ++v) {
+    buffer.clear();
+    for (int i = cells_of_vertex_count[v]; i < cells_of_vertex_count[v + 1]; ++i)
+      for (int w : mesh.cell(cells_of_vertex[i])) buffer.push_back(w);
+    std::sort(buffer.begin(), buffer.end(),
+              [&](int a, int b) { return mesh.global_vertex[a] < mesh.global_vertex[b]; });
+    buffer.erase(std::unique(buffer.begin(), buffer.end()), buffer.end());
+    neighbours.insert(neighbours.end(), buffer.begin(), buffer.end());
+    node_offsets_[static_cast<std::size_t>(v) + 1] = static_cast<PetscInt>(neighbours.size());
+  }
+  // Each cell's entry (a, b), a owned: the position of b among a's neighbours.
+  slots_.assign(cells_.size() * k * k, -1);
+  for (std::size_t index = 0; index < cells_.size(); ++index) {
+    const auto vertices = mesh.cell(cells_[index]);
+    for (int a = 0; a < k; ++a) {
+      const int v = vertices[a];
+      if (v >= n_owned) continue;
+      const auto first = neighbours.begin() + node_offsets_[v],
+                 last = neighbours.begin() + node_offsets_[v + 1];
+      for (int b = 0; b < k; ++b) {
+        const PetscInt global = mesh.global_vertex[vertices[b]];
+        const auto found = std::lower_bound(
+            first, last, global, [&](int w, PetscInt g) { return mesh.global_vertex[w] < g; });
+        slots_[index * k * k + static_cast<std::size_t>(a) * k + b] =
+            static_cast<int>(found - first);
+      }
+    }
+  }
+  // The dof pattern: row (v, i) holds columns (w, j) for every neighbour w, every j, sorted.
+  const std::size_t n_rows = static_cast<std::size_t>(n_owned) * n;
+  std::vector<PetscInt> row_offsets(n_rows + 1, 0),
+      columns(static_cast<std::size_t>(node_offsets_.back()) * n * n);
+  for (int v = 0; v < n_owned; ++v) {
+    const PetscInt degree = node_offsets_[v + 1] - node_offsets_[v];
+    for (int i = 0; i < n; ++i) {
+      const std::size_t row = static_cast<std::size_t>(v) * n + i;
+      const PetscInt start = node_offsets_[v] * n * n + i * degree * n;
+      row_offsets[row] = start;
+      for (PetscInt m = 0; m < degree; ++m)
+        for (int j = 0; j < n; ++j)
+          columns[static_cast<std::size_t>(start + m * n + j)] =
+              mesh.global_vertex[neighbours[node_offsets_[v] + m]] * n + j;
+    }
+  }
+  row_offsets[n_rows] = static_cast<PetscInt>(columns.size());
+  values_.assign(columns.size(), 0.0);
+  element_.assign(static_cast<std::size_t>(k * n) * (k * n), 0.0);
+  const PetscInt n_local = static_cast<PetscInt>(n_rows);
+  COAPT_PETSC_CHECK(MatCreateMPIAIJWithArrays(mesh.comm, n_local, n_local, PETSC_DETERMINE,
+                                              PETSC_DETERMINE, row_offsets.data(), columns.data(),
+                                              values_.data(), matrix_.out()));
+  COAPT_PETSC_CHECK(MatSetBlockSize(matrix_, n));
+  COAPT_PETSC_CHECK(MatSetOption(matrix_, MAT_NEW_NONZERO_LOCATION_ERR, PETSC_TRUE));
 }
 
 void P1Matrix::finish_assembly() {
-  COAPT_PETSC_CHECK(MatSetValuesCOO(matrix_, values_.data(), INSERT_VALUES));
+  COAPT_PETSC_CHECK(MatUpdateMPIAIJWithArray(matrix_, values_.data()));
 }
 
 std::vector<PetscInt> boundary_dofs(const mesh::Mesh& mesh, int n_components, int tag,

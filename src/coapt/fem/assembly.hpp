@@ -43,30 +43,64 @@ class LocalValues {
   PetscInt size_ = 0;
 };
 
-/// An MPIAIJ matrix over the P1 dofs of a mesh, assembled cell by cell over the owned cells.
+/// An MPIAIJ matrix over the P1 dofs of a mesh. Each rank assembles its own rows completely
+/// from its local cells (owned and ghost: the ghost layer holds every cell touching an owned
+/// vertex), so assembly needs no communication; the CSR pattern and, for every cell, the
+/// positions of its entries in that pattern are computed once, and re-assembly writes values
+/// straight into the CSR array handed to PETSc (MatUpdateMPIAIJWithArray).
 class P1Matrix {
  public:
-  /// Creates the matrix and its COO pattern (collective on mesh.comm). `mesh` must outlive it.
+  /// Creates the matrix (all zero) and its pattern. Collective on mesh.comm. `mesh` must
+  /// outlive the matrix and keep its connectivity.
   P1Matrix(const mesh::Mesh& mesh, int n_components);
 
   /// Assembles: `kernel(c, element_matrix)` writes the (k·n)×(k·n) row-major element matrix of
-  /// owned cell c (k = dim + 1 vertices, n components, node-major dofs a·n + i). Collective.
+  /// local cell c (k = dim + 1 vertices, n components, node-major dofs a·n + i). It is called
+  /// for every local cell with an owned vertex, ghost cells included. Collective.
   template <class Kernel>
   void assemble(Kernel&& kernel) {
-    const std::size_t block = static_cast<std::size_t>(element_size_) * element_size_;
-    for (int c = 0; c < mesh_.n_owned_cells; ++c) kernel(c, values_.data() + c * block);
+    std::fill(values_.begin(), values_.end(), 0.0);
+    const std::size_t k = static_cast<std::size_t>(mesh_.vertices_per_cell());
+    for (std::size_t index = 0; index < cells_.size(); ++index) {
+      kernel(cells_[index], element_.data());
+      add_element(index, k);
+    }
     finish_assembly();
   }
   Mat mat() const { return matrix_.get(); }
   int n_components() const { return n_components_; }
 
  private:
+  void add_element(std::size_t index, std::size_t k) {
+    const int n = n_components_;
+    const int* slots = slots_.data() + index * k * k;
+    const int* vertices = mesh_.cell(cells_[index]).data();
+    const std::size_t row_size = k * n;
+    for (std::size_t a = 0; a < k; ++a) {
+      const int v = vertices[a];
+      if (v >= mesh_.n_owned_vertices) continue;
+      const PetscInt degree = node_offsets_[v + 1] - node_offsets_[v];
+      PetscScalar* block = values_.data() + static_cast<std::size_t>(node_offsets_[v]) * n * n;
+      for (int i = 0; i < n; ++i) {
+        PetscScalar* row = block + static_cast<std::size_t>(i) * degree * n;
+        const PetscScalar* element_row = element_.data() + (a * n + i) * row_size;
+        for (std::size_t b = 0; b < k; ++b) {
+          PetscScalar* target = row + static_cast<std::size_t>(slots[a * k + b]) * n;
+          for (int j = 0; j < n; ++j) target[j] += element_row[b * n + j];
+        }
+      }
+    }
+  }
   void finish_assembly();
+
   const mesh::Mesh& mesh_;
   int n_components_;
-  int element_size_;
+  std::vector<int> cells_;              ///< local cells with an owned vertex
+  std::vector<PetscInt> node_offsets_;  ///< CSR of the owned vertices' neighbours (n_owned + 1)
+  std::vector<int> slots_;              ///< per cell, k×k: position of b in a's neighbours
+  std::vector<PetscScalar> values_;     ///< CSR values of the owned dof rows
+  std::vector<PetscScalar> element_;    ///< element matrix buffer
   OwnedMat matrix_;
-  std::vector<PetscScalar> values_;
 };
 
 /// Assembles a vector: `kernel(c, element_vector)` writes the k·n entries of owned cell c,
@@ -103,7 +137,8 @@ void assemble_vector(const mesh::Mesh& mesh, int n_components, Vec vector, Kerne
     const auto vertices = mesh.cell(c);
     for (int a = 0; a < k; ++a)
       for (int i = 0; i < n_components; ++i)
-        data[static_cast<std::size_t>(vertices[a]) * n_components + i] += element[a * n_components + i];
+        data[static_cast<std::size_t>(vertices[a]) * n_components + i] +=
+            element[a * n_components + i];
   }
   VecRestoreArray(local, &data);
   VecGhostRestoreLocalForm(vector, &local);

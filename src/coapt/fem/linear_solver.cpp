@@ -6,7 +6,8 @@
 
 namespace coapt::fem {
 
-LinearSolver::LinearSolver(MPI_Comm comm, const std::string& prefix, const LinearSolverDefaults& defaults)
+LinearSolver::LinearSolver(MPI_Comm comm, const std::string& prefix,
+                           const LinearSolverDefaults& defaults)
     : prefix_(prefix) {
   COAPT_PETSC_CHECK(KSPCreate(comm, ksp_.out()));
   COAPT_PETSC_CHECK(KSPSetOptionsPrefix(ksp_, prefix.c_str()));
@@ -31,10 +32,12 @@ SolveStats LinearSolver::solve(Vec rhs, Vec solution) {
   COAPT_PETSC_CHECK(KSPGetConvergedReason(ksp_, &reason));
   COAPT_PETSC_CHECK(KSPGetIterationNumber(ksp_, &iterations));
   COAPT_PETSC_CHECK(KSPGetResidualNorm(ksp_, &residual));
-  SolveStats stats{static_cast<int>(iterations), static_cast<double>(residual), KSPConvergedReasons[reason]};
+  SolveStats stats{static_cast<int>(iterations), static_cast<double>(residual),
+                   KSPConvergedReasons[reason]};
   if (reason < 0)
-    throw ConvergenceError(fmt::format("linear solver -{} did not converge: {} after {} iterations, residual norm {:.3e}",
-                                       prefix_, stats.reason, stats.iterations, stats.residual_norm));
+    throw ConvergenceError(fmt::format(
+        "linear solver -{} did not converge: {} after {} iterations, residual norm {:.3e}", prefix_,
+        stats.reason, stats.iterations, stats.residual_norm));
   return stats;
 }
 
@@ -45,7 +48,8 @@ std::string LinearSolver::describe() const {
   KSPGetType(ksp_, &ksp_type);
   KSPGetPC(ksp_, &pc);
   PCGetType(pc, &pc_type);
-  return fmt::format("{} + {} (options prefix -{})", ksp_type ? ksp_type : "?", pc_type ? pc_type : "?", prefix_);
+  return fmt::format("{} + {} (options prefix -{})", ksp_type ? ksp_type : "?",
+                     pc_type ? pc_type : "?", prefix_);
 }
 
 }  // namespace coapt::fem

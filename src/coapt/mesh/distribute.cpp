@@ -32,7 +32,8 @@ void receive_vector(std::vector<T>& data, int from, MPI_Comm comm) {
   long long n = 0;
   MPI_Recv(&n, 1, MPI_LONG_LONG, from, 0, comm, MPI_STATUS_IGNORE);
   data.resize(static_cast<std::size_t>(n));
-  if (n > 0) MPI_Recv(data.data(), static_cast<int>(n), mpi_type<T>(), from, 0, comm, MPI_STATUS_IGNORE);
+  if (n > 0)
+    MPI_Recv(data.data(), static_cast<int>(n), mpi_type<T>(), from, 0, comm, MPI_STATUS_IGNORE);
 }
 
 void broadcast_string(std::string& text, MPI_Comm comm) {
@@ -69,7 +70,8 @@ VertexCells vertex_cells(const Mesh& whole) {
   adjacency.cells.resize(whole.cells.size());
   std::vector<int> fill(adjacency.offsets.begin(), adjacency.offsets.end() - 1);
   for (int c = 0; c < nc; ++c)
-    for (int a = 0; a < k; ++a) adjacency.cells[fill[whole.cells[static_cast<std::size_t>(c) * k + a]]++] = c;
+    for (int a = 0; a < k; ++a)
+      adjacency.cells[fill[whole.cells[static_cast<std::size_t>(c) * k + a]]++] = c;
   return adjacency;
 }
 
@@ -126,14 +128,16 @@ Mesh extract_part(const Mesh& whole, const std::vector<int>& cell_part,
     if (vertex_owner[v] == part) ++local.n_owned_vertices;
     local.global_vertex.push_back(new_number[v]);
     local.original_vertex.push_back(whole.original_vertex[v]);
-    for (int d = 0; d < dim; ++d) local.coordinates.push_back(whole.coordinates[static_cast<std::size_t>(v) * dim + d]);
+    for (int d = 0; d < dim; ++d)
+      local.coordinates.push_back(whole.coordinates[static_cast<std::size_t>(v) * dim + d]);
   }
 
   std::vector<int> local_cell(static_cast<std::size_t>(whole.n_cells()), -1);
   for (std::size_t i = 0; i < cell_order.size(); ++i) {
     const int c = cell_order[i];
     local_cell[c] = static_cast<int>(i);
-    for (int a = 0; a < k; ++a) local.cells.push_back(local_index[whole.cells[static_cast<std::size_t>(c) * k + a]]);
+    for (int a = 0; a < k; ++a)
+      local.cells.push_back(local_index[whole.cells[static_cast<std::size_t>(c) * k + a]]);
     local.cell_tags.push_back(whole.cell_tags[c]);
     local.original_cell.push_back(whole.original_cell[c]);
   }
@@ -142,7 +146,8 @@ Mesh extract_part(const Mesh& whole, const std::vector<int>& cell_part,
   for (int f = 0; f < whole.n_facets(); ++f) {
     const int c = whole.facet_cell[f];
     if (c < 0 || local_cell[c] < 0) continue;
-    for (int a = 0; a < dim; ++a) local.facets.push_back(local_index[whole.facets[static_cast<std::size_t>(f) * dim + a]]);
+    for (int a = 0; a < dim; ++a)
+      local.facets.push_back(local_index[whole.facets[static_cast<std::size_t>(f) * dim + a]]);
     local.facet_tags.push_back(whole.facet_tags[f]);
     local.facet_cell.push_back(local_cell[c]);
   }
@@ -150,8 +155,9 @@ Mesh extract_part(const Mesh& whole, const std::vector<int>& cell_part,
 }
 
 void send_part(const Mesh& part, int to, MPI_Comm comm) {
-  const long long header[6] = {part.dim, part.n_owned_vertices, part.vertex_offset,
-                               part.n_global_vertices, part.n_owned_cells, part.n_global_cells};
+  const long long header[6] = {part.dim,           part.n_owned_vertices,
+                               part.vertex_offset, part.n_global_vertices,
+                               part.n_owned_cells, part.n_global_cells};
   MPI_Send(header, 6, MPI_LONG_LONG, to, 0, comm);
   send_vector(part.coordinates, to, comm);
   send_vector(part.global_vertex, to, comm);
@@ -196,7 +202,8 @@ std::vector<int> partition_cells(const Mesh& whole, int n_parts, Partitioner par
     throw InputError(whole.source + ": " + std::to_string(nc) + " cells cannot be shared by " +
                      std::to_string(n_parts) + " ranks");
   if (partitioner == Partitioner::blocks) {
-    for (int c = 0; c < nc; ++c) part[c] = static_cast<int>(static_cast<long long>(c) * n_parts / nc);
+    for (int c = 0; c < nc; ++c)
+      part[c] = static_cast<int>(static_cast<long long>(c) * n_parts / nc);
     return part;
   }
   idx_t n_cells = nc, n_vertices = whole.n_vertices(), n_common = whole.dim, n_partitions = n_parts;
@@ -205,7 +212,8 @@ std::vector<int> partition_cells(const Mesh& whole, int n_parts, Partitioner par
   std::vector<idx_t> offsets(static_cast<std::size_t>(nc) + 1);
   for (int c = 0; c <= nc; ++c) offsets[c] = static_cast<idx_t>(c) * k;
   std::vector<idx_t> indices(whole.cells.begin(), whole.cells.end());
-  std::vector<idx_t> cell_part(static_cast<std::size_t>(nc)), vertex_part(static_cast<std::size_t>(n_vertices));
+  std::vector<idx_t> cell_part(static_cast<std::size_t>(nc)),
+      vertex_part(static_cast<std::size_t>(n_vertices));
   idx_t options[METIS_NOPTIONS];
   METIS_SetDefaultOptions(options);
   options[METIS_OPTION_SEED] = 7;
@@ -214,12 +222,14 @@ std::vector<int> partition_cells(const Mesh& whole, int n_parts, Partitioner par
                                         nullptr, nullptr, &n_common, &n_partitions, nullptr,
                                         options, &objective, cell_part.data(), vertex_part.data());
   if (status != METIS_OK)
-    throw Error(whole.source + ": METIS could not partition the mesh (status " + std::to_string(status) + ")");
+    throw Error(whole.source + ": METIS could not partition the mesh (status " +
+                std::to_string(status) + ")");
   std::copy(cell_part.begin(), cell_part.end(), part.begin());
   // METIS may leave a part empty on tiny meshes: fall back to blocks then.
   std::vector<int> counts(static_cast<std::size_t>(n_parts), 0);
   for (int p : part) ++counts[p];
-  if (std::count(counts.begin(), counts.end(), 0) > 0) return partition_cells(whole, n_parts, Partitioner::blocks);
+  if (std::count(counts.begin(), counts.end(), 0) > 0)
+    return partition_cells(whole, n_parts, Partitioner::blocks);
   return part;
 }
 
@@ -243,7 +253,8 @@ Mesh distribute(const Mesh& whole, MPI_Comm comm, Partitioner partitioner) {
       for (int v = 0; v < nv; ++v)
         if (vertex_owner[v] < size) ++offsets[static_cast<std::size_t>(vertex_owner[v]) + 1];
       std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
-      std::vector<PetscInt> next(offsets.begin(), offsets.end() - 1), new_number(static_cast<std::size_t>(nv), -1);
+      std::vector<PetscInt> next(offsets.begin(), offsets.end() - 1),
+          new_number(static_cast<std::size_t>(nv), -1);
       for (int v = 0; v < nv; ++v)
         if (vertex_owner[v] < size) new_number[v] = next[vertex_owner[v]]++;
       const auto adjacency = vertex_cells(whole);

@@ -18,14 +18,14 @@ namespace coapt::mesh {
 
 /// The parameters of a `mesh` section, read once.
 struct MeshInput {
-  std::string type;                 ///< rectangle | box | gmsh | geo
-  std::string file;                 ///< .msh or .geo (gmsh, geo), resolved against the case folder
-  std::vector<double> lower;        ///< generator box corner [m]
-  std::vector<double> upper;        ///< generator box corner [m]
-  std::vector<int> cells;           ///< cells per direction at level 0 (structured)
-  bool structured = true;           ///< structured (generators) or Gmsh's unstructured mesher
-  double size = 0;                  ///< element size at level 0 (unstructured, geo) [m]
-  int level = 0;                    ///< refinement level: each level halves the size
+  std::string type;           ///< rectangle | box | gmsh | geo
+  std::string file;           ///< .msh or .geo (gmsh, geo), resolved against the case folder
+  std::vector<double> lower;  ///< generator box corner [m]
+  std::vector<double> upper;  ///< generator box corner [m]
+  std::vector<int> cells;     ///< cells per direction at level 0 (structured)
+  bool structured = true;     ///< structured (generators) or Gmsh's unstructured mesher
+  double size = 0;            ///< element size at level 0 (unstructured, geo) [m]
+  int level = 0;              ///< refinement level: each level halves the size
   Partitioner partitioner = Partitioner::metis;
 
   /// Reads and checks the section. `dim` is 2 or 3 for generators (0: any).

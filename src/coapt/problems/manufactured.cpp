@@ -25,10 +25,11 @@ constexpr double pi = std::numbers::pi;
 
 // The exact solutions are sums of plane waves sin(π w_k·x) (cos for the Poisson's second
 // term), so f follows in closed form for any dimension:
-//   Poisson:    u = sin(π w0·x) + cos(π w1·x),  f = −Δu = π²|w0|² sin(π w0·x) + π²|w1|² cos(π w1·x);
-//   elasticity: u_i = sin(π w_i·x),  −div σ = −μ Δu − (λ+μ) ∇(div u), so
+//   Poisson:    u = sin(π w0·x) + cos(π w1·x),  f = −Δu = π²|w0|² sin(π w0·x) + π²|w1|² cos(π
+//   w1·x); elasticity: u_i = sin(π w_i·x),  −div σ = −μ Δu − (λ+μ) ∇(div u), so
 //               f_i = μ π² |w_i|² sin(π w_i·x) + (λ+μ) π² Σ_k w_kk w_ki sin(π w_k·x).
-const std::array<Vector3, 3> kWaves = {Vector3(1.0, 0.5, 0.3), Vector3(0.4, 1.2, 0.2), Vector3(0.3, 0.6, 0.9)};
+const std::array<Vector3, 3> kWaves = {Vector3(1.0, 0.5, 0.3), Vector3(0.4, 1.2, 0.2),
+                                       Vector3(0.3, 0.6, 0.9)};
 
 template <int Dim>
 double wave_phase(int k, const Eigen::Matrix<double, Dim, 1>& x) {
@@ -39,7 +40,8 @@ double wave_phase(int k, const Eigen::Matrix<double, Dim, 1>& x) {
 struct PoissonSolution {
   template <int Dim>
   static Eigen::Matrix<double, 1, 1> value(const Eigen::Matrix<double, Dim, 1>& x) {
-    return Eigen::Matrix<double, 1, 1>(std::sin(wave_phase<Dim>(0, x)) + std::cos(wave_phase<Dim>(1, x)));
+    return Eigen::Matrix<double, 1, 1>(std::sin(wave_phase<Dim>(0, x)) +
+                                       std::cos(wave_phase<Dim>(1, x)));
   }
   template <int Dim>
   static Eigen::Matrix<double, 1, Dim> gradient(const Eigen::Matrix<double, Dim, 1>& x) {
@@ -48,9 +50,11 @@ struct PoissonSolution {
         .transpose();
   }
   template <int Dim>
-  static Eigen::Matrix<double, 1, 1> source(const Eigen::Matrix<double, Dim, 1>& x, double, double) {
+  static Eigen::Matrix<double, 1, 1> source(const Eigen::Matrix<double, Dim, 1>& x, double,
+                                            double) {
     const double w0 = kWaves[0].head<Dim>().squaredNorm(), w1 = kWaves[1].head<Dim>().squaredNorm();
-    return Eigen::Matrix<double, 1, 1>(pi * pi * (w0 * std::sin(wave_phase<Dim>(0, x)) + w1 * std::cos(wave_phase<Dim>(1, x))));
+    return Eigen::Matrix<double, 1, 1>(
+        pi * pi * (w0 * std::sin(wave_phase<Dim>(0, x)) + w1 * std::cos(wave_phase<Dim>(1, x))));
   }
 };
 
@@ -64,16 +68,21 @@ struct ElasticitySolution {
   template <int Dim>
   static Eigen::Matrix<double, Dim, Dim> gradient(const Eigen::Matrix<double, Dim, 1>& x) {
     Eigen::Matrix<double, Dim, Dim> g;
-    for (int i = 0; i < Dim; ++i) g.row(i) = pi * std::cos(wave_phase<Dim>(i, x)) * kWaves[i].head<Dim>().transpose();
+    for (int i = 0; i < Dim; ++i)
+      g.row(i) = pi * std::cos(wave_phase<Dim>(i, x)) * kWaves[i].head<Dim>().transpose();
     return g;
   }
   template <int Dim>
-  static Eigen::Matrix<double, Dim, 1> source(const Eigen::Matrix<double, Dim, 1>& x, double lambda, double mu) {
+  static Eigen::Matrix<double, Dim, 1> source(const Eigen::Matrix<double, Dim, 1>& x, double lambda,
+                                              double mu) {
     Eigen::Matrix<double, Dim, 1> f;
     for (int i = 0; i < Dim; ++i) {
       double grad_div = 0;
-      for (int k = 0; k < Dim; ++k) grad_div += kWaves[k](k) * kWaves[k](i) * std::sin(wave_phase<Dim>(k, x));
-      f(i) = pi * pi * (mu * kWaves[i].head<Dim>().squaredNorm() * std::sin(wave_phase<Dim>(i, x)) + (lambda + mu) * grad_div);
+      for (int k = 0; k < Dim; ++k)
+        grad_div += kWaves[k](k) * kWaves[k](i) * std::sin(wave_phase<Dim>(k, x));
+      f(i) = pi * pi *
+             (mu * kWaves[i].head<Dim>().squaredNorm() * std::sin(wave_phase<Dim>(i, x)) +
+              (lambda + mu) * grad_div);
     }
     return f;
   }
@@ -94,21 +103,25 @@ template <class Solution>
 class Manufactured final : public run::Problem {
  public:
   Manufactured(std::string name, const config::Section& root, MPI_Comm comm, bool elastic)
-      : name_(std::move(name)), parameters_(read(root, elastic)), comm_(comm),
+      : name_(std::move(name)),
+        parameters_(read(root, elastic)),
+        comm_(comm),
         mesh_(mesh::load_mesh(parameters_.mesh, comm, &quality_)),
         n_components_(elastic ? mesh_.dim : 1) {
     for (const auto& name : parameters_.dirichlet) {
       const auto* group = mesh_.find_group(name);
       if (!group || group->dim != mesh_.dim - 1)
         throw InputError(fmt::format("{}: dirichlet: {}: no boundary group '{}' in the mesh ({})",
-                                     parameters_.dirichlet_where, mesh_.source, name, boundary_group_names()));
+                                     parameters_.dirichlet_where, mesh_.source, name,
+                                     boundary_group_names()));
       dirichlet_tags_.push_back(group->tag);
     }
     if (parameters_.dirichlet.empty())
       for (const auto& group : mesh_.groups)
         if (group.dim == mesh_.dim - 1) dirichlet_tags_.push_back(group.tag);
     if (dirichlet_tags_.empty())
-      throw InputError(fmt::format("{}: the mesh has no tagged boundary for the Dirichlet condition", mesh_.source));
+      throw InputError(fmt::format(
+          "{}: the mesh has no tagged boundary for the Dirichlet condition", mesh_.source));
   }
 
   void describe() const override {
@@ -135,16 +148,22 @@ class Manufactured final : public run::Problem {
     p.mesh = mesh::MeshInput::read(root.section("mesh", "the mesh"), root.case_directory());
     if (elastic) {
       auto material = root.section("material", "linear elastic material");
-      const double young = material.get<double>("young_modulus", 1.0, {"Pa", "Young's modulus E", Bounds::positive()});
-      const double poisson = material.get<double>("poisson_ratio", 0.3, {"", "Poisson's ratio", Bounds::open(-1.0, 0.5)});
+      const double young = material.get<double>("young_modulus", 1.0,
+                                                {"Pa", "Young's modulus E", Bounds::positive()});
+      const double poisson = material.get<double>("poisson_ratio", 0.3,
+                                                  {"", "Poisson's ratio", Bounds::open(-1.0, 0.5)});
       p.lambda = young * poisson / ((1 + poisson) * (1 - 2 * poisson));
       p.mu = young / (2 * (1 + poisson));
     }
     auto output = root.section("output", "what the run writes");
     p.write_vtk = output.get<bool>("vtk", true, {"", "write the solution and its error as VTK"});
-    p.dirichlet = root.get<std::vector<std::string>>("dirichlet", {}, {"", "boundary groups where u = the exact solution (empty: every boundary group)"});
+    p.dirichlet = root.get<std::vector<std::string>>(
+        "dirichlet", {},
+        {"", "boundary groups where u = the exact solution (empty: every boundary group)"});
     p.dirichlet_where = root.where("dirichlet");
-    p.quadrature_degree = root.get<int>("quadrature_degree", 4, {"", "degree of the rule for f and the errors", Bounds::closed(2, 10)});
+    p.quadrature_degree =
+        root.get<int>("quadrature_degree", 4,
+                      {"", "degree of the rule for f and the errors", Bounds::closed(2, 10)});
     return p;
   }
 
@@ -183,7 +202,8 @@ class Manufactured final : public run::Problem {
         const auto points = fem::quadrature_points<Dim>(x, rule);
         Eigen::MatrixXd f(rule.size(), n);
         for (int q = 0; q < rule.size(); ++q)
-          f.row(q) = Solution::template source<Dim>(points.row(q).transpose(), lambda, mu).transpose();
+          f.row(q) =
+              Solution::template source<Dim>(points.row(q).transpose(), lambda, mu).transpose();
         const auto load = fem::element_load<Dim>(geometry, rule, f);
         for (int a = 0; a < k; ++a)
           for (int i = 0; i < n; ++i) element[a * n + i] = load(a, i);
@@ -211,7 +231,8 @@ class Manufactured final : public run::Problem {
     COAPT_PETSC_CHECK(VecAssemblyEnd(boundary_values));
     fem::apply_dirichlet(matrix.mat(), rhs, dofs, boundary_values);
 
-    fem::LinearSolver solver(comm_, name_ + "_", {n == 1 ? "cg" : "cg", "gamg", 1e-12, 1e-50, 2000});
+    fem::LinearSolver solver(comm_, name_ + "_",
+                             {n == 1 ? "cg" : "cg", "gamg", 1e-12, 1e-50, 2000});
     if (n > 1) set_rigid_body_modes(matrix.mat());
     solver.set_operator(matrix.mat());
     fem::SolveStats stats;
@@ -220,8 +241,8 @@ class Manufactured final : public run::Problem {
       stats = solver.solve(rhs, solution);
     }
     fem::update_ghosts(solution);
-    log::info("solver {}: {} iterations, {}, residual {:.3e}", solver.describe(), stats.iterations, stats.reason,
-              stats.residual_norm);
+    log::info("solver {}: {} iterations, {}, residual {:.3e}", solver.describe(), stats.iterations,
+              stats.reason, stats.residual_norm);
 
     // Errors over the owned cells: ‖u_h − u‖_L2 and |u_h − u|_H1 with a degree-q rule.
     double l2 = 0, h1 = 0, h_max = 0;
@@ -233,15 +254,18 @@ class Manufactured final : public run::Problem {
         const auto geometry = fem::p1_geometry<Dim>(x);
         Eigen::Matrix<double, k, Eigen::Dynamic> nodal(k, n);
         for (int a = 0; a < k; ++a)
-          for (int i = 0; i < n; ++i) nodal(a, i) = u_h[static_cast<std::size_t>(mesh_.cell(c)[a]) * n + i];
+          for (int i = 0; i < n; ++i)
+            nodal(a, i) = u_h[static_cast<std::size_t>(mesh_.cell(c)[a]) * n + i];
         const Eigen::MatrixXd gradient_h = nodal.transpose() * geometry.gradients;  // n × Dim
         double cell_l2 = 0, cell_h1 = 0;
         for (int q = 0; q < rule.size(); ++q) {
           const Eigen::Map<const Eigen::Matrix<double, Dim, 1>> xi(rule.point(q));
           const auto lambda_q = fem::p1_values<Dim>(xi);
           const Eigen::Matrix<double, Dim, 1> point = fem::map_to_physical<Dim>(x, xi);
-          const Eigen::VectorXd difference = nodal.transpose() * lambda_q - Eigen::VectorXd(Solution::template value<Dim>(point));
-          const Eigen::MatrixXd gradient_difference = gradient_h - Eigen::MatrixXd(Solution::template gradient<Dim>(point));
+          const Eigen::VectorXd difference =
+              nodal.transpose() * lambda_q - Eigen::VectorXd(Solution::template value<Dim>(point));
+          const Eigen::MatrixXd gradient_difference =
+              gradient_h - Eigen::MatrixXd(Solution::template gradient<Dim>(point));
           const double weight = rule.weights[q] * fem::detail::factorial(Dim) * geometry.measure;
           cell_l2 += weight * difference.squaredNorm();
           cell_h1 += weight * gradient_difference.squaredNorm();
@@ -303,7 +327,10 @@ class Manufactured final : public run::Problem {
     auto coordinates = fem::create_vertex_vector(mesh_, mesh_.dim);
     PetscScalar* data = nullptr;
     COAPT_PETSC_CHECK(VecGetArray(coordinates, &data));
-    std::copy(mesh_.coordinates.begin(), mesh_.coordinates.begin() + static_cast<std::ptrdiff_t>(mesh_.n_owned_vertices) * mesh_.dim, data);
+    std::copy(
+        mesh_.coordinates.begin(),
+        mesh_.coordinates.begin() + static_cast<std::ptrdiff_t>(mesh_.n_owned_vertices) * mesh_.dim,
+        data);
     COAPT_PETSC_CHECK(VecRestoreArray(coordinates, &data));
     MatNullSpace null_space = nullptr;
     COAPT_PETSC_CHECK(MatNullSpaceCreateRigidBody(coordinates, &null_space));

@@ -8,7 +8,8 @@ const std::vector<ProblemKind>& problem_kinds() {
   static const std::vector<ProblemKind> kinds = {
       {"poisson", "Poisson equation with a manufactured solution (verification of the FEM core)",
        problems::create_poisson},
-      {"elasticity", "linear elasticity with a manufactured solution (verification of the FEM core)",
+      {"elasticity",
+       "linear elasticity with a manufactured solution (verification of the FEM core)",
        problems::create_elasticity},
   };
   return kinds;

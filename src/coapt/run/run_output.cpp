@@ -29,7 +29,9 @@ RunOutput::RunOutput(MPI_Comm comm, std::filesystem::path directory,
   run_on_root(comm_, [&] {
     std::error_code error;
     std::filesystem::create_directories(directory_, error);
-    if (error) throw InputError(directory_.string() + ": cannot create the output folder: " + error.message());
+    if (error)
+      throw InputError(directory_.string() +
+                       ": cannot create the output folder: " + error.message());
     // A previous run's summary must not survive into this one.
     std::filesystem::remove(directory_ / "summary.json", error);
     std::ofstream file(directory_ / "case.yaml");
@@ -46,7 +48,9 @@ RunOutput::RunOutput(MPI_Comm comm, std::filesystem::path directory,
   write_summary();
 }
 
-RunOutput::~RunOutput() { log::close_files(); }
+RunOutput::~RunOutput() {
+  log::close_files();
+}
 
 io::CsvSeries& RunOutput::series() {
   if (!series_) series_ = std::make_unique<io::CsvSeries>(comm_, directory_ / "series.csv");

@@ -57,11 +57,14 @@ TEST(Config, UnknownKeyNamesFileLineAndKey) {
 }
 
 TEST(Config, WrongTypeAndRangeAreRejectedWithLocation) {
-  auto doc = Document::from_string("fluid:\n  density: heavy\n  viscosity: -1\n  n: 2.5\n", "c.yaml");
+  auto doc =
+      Document::from_string("fluid:\n  density: heavy\n  viscosity: -1\n  n: 2.5\n", "c.yaml");
   auto fluid = doc.root().section("fluid");
   auto m1 = message_of([&] { fluid.get<double>("density", 1.0, {"kg/m^3", ""}); });
   EXPECT_NE(m1.find("c.yaml:2: fluid.density: expected a number"), std::string::npos) << m1;
-  auto m2 = message_of([&] { fluid.get<double>("viscosity", 1.0, {"Pa s", "", Bounds::positive()}); });
+  auto m2 = message_of([&] {
+    fluid.get<double>("viscosity", 1.0, {"Pa s", "", Bounds::positive()});
+  });
   EXPECT_NE(m2.find("c.yaml:3: fluid.viscosity: value -1 is out of range: must be > 0"),
             std::string::npos)
       << m2;
@@ -85,8 +88,9 @@ TEST(Config, SetOverridesWithTheSameChecks) {
   EXPECT_EQ(root.section("mesh").get<int>("level", 0, {"", ""}), 3);
   EXPECT_DOUBLE_EQ(root.sections("solids")[1].get<double>("density", 1.0, {"", ""}), 900.0);
   doc.set("fluid.density=-5");
-  auto m = message_of(
-      [&] { root.section("fluid").get<double>("density", 1.0, {"", "", Bounds::positive()}); });
+  auto m = message_of([&] {
+    root.section("fluid").get<double>("density", 1.0, {"", "", Bounds::positive()});
+  });
   EXPECT_NE(m.find("--set fluid.density=-5: fluid.density: value -5 is out of range"),
             std::string::npos)
       << m;
@@ -108,14 +112,18 @@ TEST(Config, MalformedYamlAndMissingFile) {
 
 TEST(Config, ChoiceRejectsUnlistedValue) {
   auto doc = Document::from_string("solver: magic\n", "c.yaml");
-  auto m = message_of([&] { doc.root().choice("solver", "direct", {"direct", "iterative"}, {"", ""}); });
-  EXPECT_NE(m.find("c.yaml:1: solver: 'magic' is not one of: direct | iterative"), std::string::npos)
+  auto m = message_of([&] {
+    doc.root().choice("solver", "direct", {"direct", "iterative"}, {"", ""});
+  });
+  EXPECT_NE(m.find("c.yaml:1: solver: 'magic' is not one of: direct | iterative"),
+            std::string::npos)
       << m;
 }
 
 TEST(Config, RecordsDocumentation) {
   auto doc = Document::from_string("", "c.yaml");
-  doc.root().section("fluid").get<double>("viscosity", 1e-3, {"Pa s", "dynamic viscosity", Bounds::positive()});
+  doc.root().section("fluid").get<double>("viscosity", 1e-3,
+                                          {"Pa s", "dynamic viscosity", Bounds::positive()});
   ASSERT_EQ(doc.keys().size(), 2u);
   EXPECT_EQ(doc.keys()[1].path, "fluid.viscosity");
   EXPECT_EQ(doc.keys()[1].unit, "Pa s");

@@ -1,0 +1,368 @@
+/// @file intersection.cpp
+/// Triangle–triangle and tetrahedron–tetrahedron intersection: rejection, inclusion,
+/// clipping, and the local integrals.
+
+#include "coapt/transfer/intersection.hpp"
+
+#include <cmath>
+#include <limits>
+
+namespace coapt::transfer {
+
+// ================================================================================================
+// Intersection of two simplices A, B (same kernel for d = 2 and d = 3).
+//
+// Algorithm.
+//  1. Degenerate element (measure 0) or disjoint bounding boxes: empty.
+//  2. Let S be the simplex of smaller measure (A on a tie) and L the other.
+//  3. β_jk = λ^L_j(s_k), the barycentric coordinates in L of the vertices of S. If for
+//     some j all β_jk ≤ tol, face plane j of L separates: empty. Planes with some
+//     β_jk < −tol cut S; if none does, S ⊂ L and A∩B = S.
+//  4. γ_ik = λ^S_i(l_k): a separating plane of S gives empty; all γ_ik ≥ −tol means
+//     L ⊂ S and A∩B = L.
+//  5. Otherwise clip S in its own reference coordinates ξ (x = s_0 + J ξ, S = the unit
+//     simplex) by the half-spaces {λ^L_j ≥ 0} of the cutting planes only, where
+//     λ^L_j(ξ) = β_j0 + Σ_k (β_jk − β_j0) ξ_k is known from step 3 (clipping.cpp).
+//  6. Moments of the clipped polytope in ξ (measure V_ξ, centroid ξ̄, central second
+//     moment C_ξ); with u = (1 − Σξ, ξ) = λ^S and its covariance C_u,
+//       ∫ λ^S_i λ^L_j = d!|S| Σ_k (V_ξ ū_i ū_k + C_u,ik) β_jk,
+//       ∫ λ^S_i = d!|S| V_ξ ū_i,  ∫ λ^L_j = d!|S| V_ξ Σ_k β_jk ū_k,
+//     exact for affine λ. When S ⊂ L or L ⊂ S the single-simplex formula
+//     ∫_T λ_k λ_l = |T| (1 + δ_kl) / ((d+1)(d+2)) gives them from β or γ directly.
+//  7. Measures ≤ kMeasureTolerance · min(|A|, |B|) are reported as empty; a measure above
+//     min(|A|, |B|) (round-off) is scaled back to it with all the integrals.
+//
+// Why reference coordinates: on a sliver S (height h ≪ size ℓ) the physical second
+// moment has an eigenvalue ~ h² that round-off at the scale ℓ² wipes out, and the
+// contraction with ∇λ ~ 1/h amplifies that error by (ℓ/h)². In ξ the polytope has size
+// O(1) whatever the shape of S, and only L's conditioning enters, once (through β).
+//
+// Invariants. λ is dimensionless, so tol = kPlaneTolerance is relative to the height of
+// the element owning the plane; the same snapping rule (|λ| ≤ tol counts as on the plane)
+// is used by the rejection, the inclusion and the clipping tests, so a point on a shared
+// face is on the same side for both elements and a mesh of cells partitions any element's
+// volume (no gap, no overlap beyond tol · height). Choosing S by measure makes (A, B) and
+// (B, A) perform the same arithmetic, so the results are symmetric to the bit except on
+// ties. Only convex combinations and divisions by strictly positive numbers occur: no NaN
+// from finite input.
+// ================================================================================================
+
+namespace {
+
+template <int dim>
+using Polytope = typename detail::PolytopeOf<dim>::type;
+
+constexpr double factorial(int n) {
+  return n <= 1 ? 1.0 : n * factorial(n - 1);
+}
+
+template <int dim>
+struct Overlap {
+  enum class Kind { empty, small_inside, large_inside, clipped };
+  Kind kind = Kind::empty;
+  bool a_is_small = true;
+  const Simplex<dim>* small = nullptr;  ///< S (A until the pair is classified)
+  const Simplex<dim>* large = nullptr;  ///< L
+  NodalMatrix<dim> beta;                ///< β_jk = λ^L_j(s_k) (set unless empty)
+  NodalMatrix<dim> gamma;               ///< γ_ik = λ^S_i(l_k) (set for large_inside and clipped)
+};
+
+template <int dim>
+Overlap<dim> find_overlap(const Simplex<dim>& a, const Simplex<dim>& b, Polytope<dim>& polytope) {
+  using Kind = typename Overlap<dim>::Kind;
+  constexpr double tol = kPlaneTolerance;
+  Overlap<dim> overlap;
+  overlap.small = &a;  // never null, even for an empty overlap
+  overlap.large = &b;
+  if (a.degenerate() || b.degenerate()) return overlap;
+  for (int k = 0; k < dim; ++k)
+    if (a.box_upper[k] < b.box_lower[k] || b.box_upper[k] < a.box_lower[k]) return overlap;
+
+  overlap.a_is_small = a.measure <= b.measure;
+  const Simplex<dim>& small = overlap.a_is_small ? a : b;
+  const Simplex<dim>& large = overlap.a_is_small ? b : a;
+  overlap.small = &small;
+  overlap.large = &large;
+
+  // 3. faces of L against the vertices of S
+  unsigned cutting = 0;
+  for (int j = 0; j <= dim; ++j) {
+    double lowest = std::numeric_limits<double>::infinity(), highest = -lowest;
+    for (int k = 0; k <= dim; ++k) {
+      const double d = large.barycentric(j, small.vertices[k]);
+      overlap.beta[j][k] = d;
+      lowest = d < lowest ? d : lowest;  // not fmin/fmax: those are library calls here
+      highest = d > highest ? d : highest;
+    }
+    if (!(highest > tol)) return overlap;  // separating plane
+    if (lowest < -tol) cutting |= 1u << j;
+  }
+  if (cutting == 0) {
+    overlap.kind = Kind::small_inside;
+    return overlap;
+  }
+
+  // 4. faces of S against the vertices of L
+  bool large_inside = true;
+  for (int i = 0; i <= dim; ++i) {
+    double lowest = std::numeric_limits<double>::infinity(), highest = -lowest;
+    for (int k = 0; k <= dim; ++k) {
+      const double d = small.barycentric(i, large.vertices[k]);
+      overlap.gamma[i][k] = d;
+      lowest = d < lowest ? d : lowest;
+      highest = d > highest ? d : highest;
+    }
+    if (!(highest > tol)) return overlap;
+    if (lowest < -tol) large_inside = false;
+  }
+  if (large_inside) {
+    overlap.kind = Kind::large_inside;
+    return overlap;
+  }
+
+  // 5. clip the unit simplex (S in its reference coordinates) by λ^L_j ≥ 0
+  std::array<Point<dim>, dim + 1> unit{};
+  for (int k = 0; k < dim; ++k) unit[k + 1][k] = 1.0;
+  if constexpr (dim == 2)
+    polytope.assign_triangle(unit);
+  else
+    polytope.assign_tetrahedron(unit);
+  for (int j = 0; j <= dim; ++j) {
+    if (!((cutting >> j) & 1u)) continue;
+    HalfSpace<dim> plane;
+    plane.offset = overlap.beta[j][0];
+    for (int k = 0; k < dim; ++k) plane.normal[k] = overlap.beta[j][k + 1] - overlap.beta[j][0];
+    if (!polytope.clip(plane, tol)) return overlap;
+  }
+  overlap.kind = Kind::clipped;
+  return overlap;
+}
+
+// x = s_0 + J ξ, J = [s_1 − s_0, ..., s_d − s_0]
+template <int dim>
+Point<dim> to_physical(const Simplex<dim>& s, const Point<dim>& xi) {
+  Point<dim> x = s.vertices[0];
+  for (int c = 0; c < dim; ++c)
+    for (int r = 0; r < dim; ++r) x[r] += (s.vertices[c + 1][r] - s.vertices[0][r]) * xi[c];
+  return x;
+}
+
+// Physical moments of a region given by its moments in the reference coordinates of s:
+// |Ω| = d!|S| V_ξ, x̄ = x(ξ̄), ∫(x − x̄)(x − x̄)ᵀ = d!|S| J C_ξ Jᵀ.
+template <int dim>
+Moments<dim> physical_moments(const Simplex<dim>& s, const Moments<dim>& reference) {
+  const double jacobian = factorial(dim) * s.measure;
+  Moments<dim> m;
+  m.measure = jacobian * reference.measure;
+  m.centroid = to_physical<dim>(s, reference.centroid);
+  std::array<Point<dim>, dim> jc{};  // J C_ξ
+  for (int r = 0; r < dim; ++r)
+    for (int c = 0; c < dim; ++c)
+      for (int k = 0; k < dim; ++k)
+        jc[r][c] += (s.vertices[k + 1][r] - s.vertices[0][r]) * reference.second[k][c];
+  for (int r = 0; r < dim; ++r)
+    for (int c = 0; c < dim; ++c) {
+      double value = 0.0;
+      for (int k = 0; k < dim; ++k) value += jc[r][k] * (s.vertices[k + 1][c] - s.vertices[0][c]);
+      m.second[r][c] = jacobian * value;
+    }
+  return m;
+}
+
+// Rejects round-off-sized results and scales a measure above min(|A|, |B|) back to it;
+// returns the factor to apply to every integral (0 when the intersection is empty).
+template <int dim>
+double admissible_scale(double measure, const Simplex<dim>& a, const Simplex<dim>& b) {
+  const double limit = std::fmin(a.measure, b.measure);
+  if (!(measure > kMeasureTolerance * limit) || !std::isfinite(measure)) return 0.0;
+  return measure > limit ? limit / measure : 1.0;
+}
+
+template <int dim>
+bool moments_of_intersection(const Simplex<dim>& a, const Simplex<dim>& b,
+                             IntersectionWorkspace<dim>& workspace, Moments<dim>& out) {
+  using Kind = typename Overlap<dim>::Kind;
+  const Overlap<dim> overlap = find_overlap(a, b, workspace.polytope);
+  Moments<dim> m;
+  switch (overlap.kind) {
+    case Kind::empty:
+      break;
+    case Kind::small_inside:
+      m = simplex_moments(*overlap.small);
+      break;
+    case Kind::large_inside:
+      m = simplex_moments(*overlap.large);
+      break;
+    case Kind::clipped:
+      m = physical_moments(*overlap.small, workspace.polytope.moments());
+      break;
+  }
+  const double scale = admissible_scale(m.measure, a, b);
+  if (scale == 0.0) {
+    out = {};
+    return false;
+  }
+  m.measure *= scale;
+  for (auto& row : m.second)
+    for (double& value : row) value *= scale;
+  out = m;
+  return true;
+}
+
+template <int dim>
+bool integrals_of_intersection(const Simplex<dim>& a, const Simplex<dim>& b,
+                               IntersectionWorkspace<dim>& workspace, LocalIntegrals<dim>& out) {
+  using Kind = typename Overlap<dim>::Kind;
+  const Overlap<dim> overlap = find_overlap(a, b, workspace.polytope);
+  const Simplex<dim>& small = *overlap.small;
+  const Simplex<dim>& large = *overlap.large;
+  constexpr double pair_factor = 1.0 / ((dim + 1) * (dim + 2));
+  Moments<dim> moments;
+  NodalMatrix<dim> mass;  // ∫ λ^S_i λ^L_j
+  NodalVector<dim> integral_s, integral_l;
+  switch (overlap.kind) {
+    case Kind::empty:
+      out = {};
+      return false;
+    case Kind::small_inside: {  // Ω = S: ∫_S λ^S_i λ^L_j = |S| (β_ji + Σ_k β_jk) / ((d+1)(d+2))
+      moments = simplex_moments(small);
+      for (int j = 0; j <= dim; ++j) {
+        double sum = 0.0;
+        for (int k = 0; k <= dim; ++k) sum += overlap.beta[j][k];
+        integral_l[j] = small.measure * sum / (dim + 1);
+        for (int i = 0; i <= dim; ++i)
+          mass[i][j] = small.measure * pair_factor * (overlap.beta[j][i] + sum);
+      }
+      for (int i = 0; i <= dim; ++i) integral_s[i] = small.measure / (dim + 1);
+      break;
+    }
+    case Kind::large_inside: {  // Ω = L: ∫_L λ^S_i λ^L_j = |L| (γ_ij + Σ_k γ_ik) / ((d+1)(d+2))
+      moments = simplex_moments(large);
+      for (int i = 0; i <= dim; ++i) {
+        double sum = 0.0;
+        for (int k = 0; k <= dim; ++k) sum += overlap.gamma[i][k];
+        integral_s[i] = large.measure * sum / (dim + 1);
+        for (int j = 0; j <= dim; ++j)
+          mass[i][j] = large.measure * pair_factor * (overlap.gamma[i][j] + sum);
+      }
+      for (int j = 0; j <= dim; ++j) integral_l[j] = large.measure / (dim + 1);
+      break;
+    }
+    case Kind::clipped: {
+      const Moments<dim> reference = workspace.polytope.moments();
+      moments = physical_moments(small, reference);
+      // ū = λ^S(ξ̄) and the covariance of u = (1 − Σξ, ξ): C_u,kl = C_ξ,kl for k, l ≥ 1,
+      // C_u,0l = −Σ_k C_ξ,kl, C_u,00 = Σ_kl C_ξ,kl.
+      NodalVector<dim> u_bar;
+      NodalMatrix<dim> covariance;
+      u_bar[0] = 1.0;
+      covariance[0][0] = 0.0;
+      for (int k = 0; k < dim; ++k) {
+        u_bar[k + 1] = reference.centroid[k];
+        u_bar[0] -= reference.centroid[k];
+        double column = 0.0;
+        for (int l = 0; l < dim; ++l) {
+          covariance[k + 1][l + 1] = reference.second[k][l];
+          column += reference.second[k][l];
+        }
+        covariance[0][k + 1] = covariance[k + 1][0] = -column;
+        covariance[0][0] += column;
+      }
+      const double jacobian = factorial(dim) * small.measure;
+      const double volume = jacobian * reference.measure;
+      for (int j = 0; j <= dim; ++j) {
+        double l_bar = 0.0;  // λ^L_j(ξ̄)
+        for (int k = 0; k <= dim; ++k) l_bar += overlap.beta[j][k] * u_bar[k];
+        integral_l[j] = volume * l_bar;
+        for (int i = 0; i <= dim; ++i) {
+          double spread = 0.0;
+          for (int k = 0; k <= dim; ++k) spread += covariance[i][k] * overlap.beta[j][k];
+          mass[i][j] = volume * u_bar[i] * l_bar + jacobian * spread;
+        }
+      }
+      for (int i = 0; i <= dim; ++i) integral_s[i] = volume * u_bar[i];
+      break;
+    }
+  }
+  const double scale = admissible_scale(moments.measure, a, b);
+  if (scale == 0.0) {
+    out = {};
+    return false;
+  }
+  out.moments = moments;
+  out.moments.measure *= scale;
+  for (auto& row : out.moments.second)
+    for (double& value : row) value *= scale;
+  for (int i = 0; i <= dim; ++i) {
+    out.integral_a[i] = scale * (overlap.a_is_small ? integral_s[i] : integral_l[i]);
+    out.integral_b[i] = scale * (overlap.a_is_small ? integral_l[i] : integral_s[i]);
+    for (int j = 0; j <= dim; ++j)
+      out.mass[i][j] = scale * (overlap.a_is_small ? mass[i][j] : mass[j][i]);
+  }
+  return true;
+}
+
+template <int dim>
+std::span<const QuadraturePoint<dim>> quadrature_of_intersection(
+    const Simplex<dim>& a, const Simplex<dim>& b, IntersectionWorkspace<dim>& workspace) {
+  using Kind = typename Overlap<dim>::Kind;
+  const Overlap<dim> overlap = find_overlap(a, b, workspace.polytope);
+  QuadraturePoint<dim>* points = workspace.quadrature.data();
+  int n = 0;
+  switch (overlap.kind) {
+    case Kind::empty:
+      return {};
+    case Kind::small_inside:
+      n = simplex_quadrature(*overlap.small, points);
+      break;
+    case Kind::large_inside:
+      n = simplex_quadrature(*overlap.large, points);
+      break;
+    case Kind::clipped: {
+      n = workspace.polytope.quadrature(points);
+      const double jacobian = factorial(dim) * overlap.small->measure;
+      for (int q = 0; q < n; ++q) {
+        points[q].point = to_physical<dim>(*overlap.small, points[q].point);
+        points[q].weight *= jacobian;
+      }
+      break;
+    }
+  }
+  double measure = 0.0;
+  for (int q = 0; q < n; ++q) measure += points[q].weight;
+  if (admissible_scale(measure, a, b) == 0.0) return {};
+  return {points, static_cast<std::size_t>(n)};
+}
+
+}  // namespace
+
+bool intersection_moments(const Simplex<2>& a, const Simplex<2>& b,
+                          IntersectionWorkspace<2>& workspace, Moments<2>& out) {
+  return moments_of_intersection(a, b, workspace, out);
+}
+bool intersection_moments(const Simplex<3>& a, const Simplex<3>& b,
+                          IntersectionWorkspace<3>& workspace, Moments<3>& out) {
+  return moments_of_intersection(a, b, workspace, out);
+}
+
+bool local_integrals(const Simplex<2>& a, const Simplex<2>& b, IntersectionWorkspace<2>& workspace,
+                     LocalIntegrals<2>& out) {
+  return integrals_of_intersection(a, b, workspace, out);
+}
+bool local_integrals(const Simplex<3>& a, const Simplex<3>& b, IntersectionWorkspace<3>& workspace,
+                     LocalIntegrals<3>& out) {
+  return integrals_of_intersection(a, b, workspace, out);
+}
+
+std::span<const QuadraturePoint<2>> intersection_quadrature(const Simplex<2>& a,
+                                                            const Simplex<2>& b,
+                                                            IntersectionWorkspace<2>& workspace) {
+  return quadrature_of_intersection(a, b, workspace);
+}
+std::span<const QuadraturePoint<3>> intersection_quadrature(const Simplex<3>& a,
+                                                            const Simplex<3>& b,
+                                                            IntersectionWorkspace<3>& workspace) {
+  return quadrature_of_intersection(a, b, workspace);
+}
+
+}  // namespace coapt::transfer

@@ -1,0 +1,19 @@
+// L-shaped domain [0,2]^2 minus [1,2]^2 (area 3), for the mesh tests.
+lc = 0.5;
+Point(1) = {0, 0, 0, lc};
+Point(2) = {2, 0, 0, lc};
+Point(3) = {2, 1, 0, lc};
+Point(4) = {1, 1, 0, lc};
+Point(5) = {1, 2, 0, lc};
+Point(6) = {0, 2, 0, lc};
+Line(1) = {1, 2};
+Line(2) = {2, 3};
+Line(3) = {3, 4};
+Line(4) = {4, 5};
+Line(5) = {5, 6};
+Line(6) = {6, 1};
+Curve Loop(1) = {1, 2, 3, 4, 5, 6};
+Plane Surface(1) = {1};
+Physical Surface("domain", 1) = {1};
+Physical Curve("bottom", 2) = {1};
+Physical Curve("rest", 3) = {2, 3, 4, 5, 6};
