@@ -77,7 +77,9 @@ int keys(const Options& options, const coapt::Context& context) {
   coapt::log::info("| --- | --- | --- | --- | --- | --- |");
   for (const auto& key : document.keys())
     coapt::log::info("| `{}` | {} | {} | {} | {} | {} |", key.path, key.type,
-                     key.default_value.empty() ? "required" : "`" + key.default_value + "`",
+                     key.type.find("section") != std::string::npos ? ""
+                     : key.default_value.empty()                   ? "required"
+                                                                   : "`" + key.default_value + "`",
                      key.unit, key.range, key.doc);
   return 0;
 }

@@ -210,10 +210,13 @@ T Section::require(std::string_view key, const KeyInfo& info) const {
 
 std::string Section::choice(std::string_view key, const std::string& default_value,
                             const std::vector<std::string>& choices, const KeyInfo& info) const {
-  std::string options;
-  for (const auto& c : choices) options += (options.empty() ? "" : " | ") + c;
+  std::string options, listed;
+  for (const auto& c : choices) {
+    options += (options.empty() ? "" : " | ") + c;
+    listed += (listed.empty() ? "" : ", ") + c;
+  }
   KeyInfo described = info;
-  const std::string doc = std::string(info.doc) + " (" + options + ")";
+  const std::string doc = std::string(info.doc) + " (one of: " + listed + ")";
   described.doc = doc;
   const std::string value = default_value.empty() ? require<std::string>(key, described)
                                                   : get<std::string>(key, default_value, described);
