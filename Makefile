@@ -12,7 +12,8 @@ JOBS ?= $(shell nproc)
 WERROR ?= $(if $(CI),ON,OFF)
 PYTHON := /usr/bin/python3
 MPIRUN := mpirun --oversubscribe --bind-to none
-DEMO_CASE ?= cases/poisson/mms3d.yaml
+DEMO_CASE ?= cases/dfg/2d1.yaml
+DEMO_SET ?= mesh.level=1
 DEMO_RANKS ?= 2
 
 export OMPI_ALLOW_RUN_AS_ROOT := 1
@@ -33,8 +34,8 @@ build: configure
 	cmake --build $(BUILD) -j $(JOBS)
 
 demo: build
-	$(MPIRUN) -np $(DEMO_RANKS) $(BUILD)/coapt run $(DEMO_CASE) --output out/demo
-	@echo "demo written to out/demo (open out/demo/solution.pvd in ParaView)"
+	$(MPIRUN) -np $(DEMO_RANKS) $(BUILD)/coapt run $(DEMO_CASE) --output out/demo --set $(DEMO_SET)
+	@echo "demo: flow around a cylinder (Schafer-Turek 2D-1) in out/demo; open out/demo/solution.pvd in ParaView"
 
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) --timeout 1500

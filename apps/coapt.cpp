@@ -163,15 +163,8 @@ int run(const Options& options, const coapt::Context& context, const std::string
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Everything after "--" is for PETSc.
-  std::vector<std::string> petsc_arguments;
   int n_ours = argc;
-  for (int i = 1; i < argc; ++i)
-    if (std::string(argv[i]) == "--") {
-      n_ours = i;
-      petsc_arguments.assign(argv + i + 1, argv + argc);
-      break;
-    }
+  const auto petsc_arguments = coapt::split_petsc_arguments(argc, argv, n_ours);
 
   Options options;
   CLI::App app{"coapt: fluid-structure-contact interaction by an immersed domain method"};

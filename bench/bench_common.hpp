@@ -3,6 +3,8 @@
 
 #include <mpi.h>
 
+#include <string>
+
 #include "coapt/core/context.hpp"
 #include "coapt/io/json.hpp"
 
@@ -18,5 +20,14 @@ struct AssemblyOptions {
 /// `coapt-bench assembly`: first assembly (pattern + values) and re-assembly (values into
 /// the existing matrix) of the P1 Laplacian and elasticity stiffness. Collective.
 io::Json assembly(const Context& context, const AssemblyOptions& options);
+
+struct TransferBenchOptions {
+  int n = 16;
+  std::string case_name = "jitter";  ///< "jitter" or "rotated"
+};
+/// `coapt-bench transfer`: search, intersection and assembly of the variational transfer
+/// operators (unit cube against a jittered copy or a rotated inner cube), and a re-assembly
+/// after a small motion of the master. Collective.
+io::Json transfer(const Context& context, const TransferBenchOptions& options);
 
 }  // namespace coapt::bench

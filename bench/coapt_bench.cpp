@@ -18,14 +18,8 @@
 #include "coapt/core/log.hpp"
 
 int main(int argc, char** argv) {
-  std::vector<std::string> petsc_arguments;
   int n_ours = argc;
-  for (int i = 1; i < argc; ++i)
-    if (std::string(argv[i]) == "--") {
-      n_ours = i;
-      petsc_arguments.assign(argv + i + 1, argv + argc);
-      break;
-    }
+  const auto petsc_arguments = coapt::split_petsc_arguments(argc, argv, n_ours);
   CLI::App app{"coapt-bench: coapt's benchmarks"};
   app.require_subcommand(1);
   coapt::bench::AssemblyOptions assembly;
@@ -35,6 +29,12 @@ int main(int argc, char** argv) {
   assembly_command
       ->add_option("--repeat", assembly.repeat, "re-assemblies timed (the mean is reported)")
       ->check(CLI::Range(1, 1000));
+  coapt::bench::TransferBenchOptions transfer;
+  auto* transfer_command = app.add_subcommand(
+      "transfer", "variational transfer operators: unit cube (n^3 * 6 tets) against a master");
+  transfer_command->add_option("--n", transfer.n, "cells per direction")->check(CLI::Range(1, 400));
+  transfer_command->add_option("--case", transfer.case_name, "jitter or rotated")
+      ->check(CLI::IsMember({"jitter", "rotated"}));
   try {
     app.parse(n_ours, argv);
   } catch (const CLI::ParseError& e) {
@@ -45,6 +45,7 @@ int main(int argc, char** argv) {
     coapt::log::initialize(context.rank());
     coapt::io::Json figures;
     if (*assembly_command) figures = coapt::bench::assembly(context, assembly);
+    if (*transfer_command) figures = coapt::bench::transfer(context, transfer);
     figures["peak_rss_mb"] = coapt::bench::peak_rss_mb(context.comm());
     if (context.rank() == 0) std::cout << figures.dump(-1) << std::endl;
   } catch (const coapt::Error& e) {

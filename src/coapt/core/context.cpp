@@ -56,6 +56,16 @@ std::vector<std::string> Context::unused_petsc_options() {
   return unused;
 }
 
+std::vector<std::string> split_petsc_arguments(int argc, char** argv, int& n_ours) {
+  n_ours = argc;
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--") {
+      n_ours = i;
+      return std::vector<std::string>(argv + i + 1, argv + argc);
+    }
+  return {};
+}
+
 int rank_of(MPI_Comm comm) {
   int rank = 0;
   MPI_Comm_rank(comm, &rank);

@@ -32,6 +32,10 @@ class Context {
   int size_ = 1;
 };
 
+/// The command-line words after "--" (PETSc options); `n_ours` is set to the number of
+/// words before it (all of argc when there is no "--").
+std::vector<std::string> split_petsc_arguments(int argc, char** argv, int& n_ours);
+
 /// Rank of this process in `comm`.
 int rank_of(MPI_Comm comm);
 /// Number of processes in `comm`.

@@ -127,6 +127,20 @@ void P1Matrix::finish_assembly() {
   COAPT_PETSC_CHECK(MatUpdateMPIAIJWithArray(matrix_, values_.data()));
 }
 
+void set_rigid_body_modes(const mesh::Mesh& mesh, Mat matrix) {
+  auto coordinates = create_vertex_vector(mesh, mesh.dim);
+  PetscScalar* data = nullptr;
+  COAPT_PETSC_CHECK(VecGetArray(coordinates, &data));
+  std::copy_n(mesh.coordinates.begin(), static_cast<std::size_t>(mesh.n_owned_vertices) * mesh.dim,
+              data);
+  COAPT_PETSC_CHECK(VecRestoreArray(coordinates, &data));
+  MatNullSpace null_space = nullptr;
+  COAPT_PETSC_CHECK(MatNullSpaceCreateRigidBody(coordinates, &null_space));
+  const PetscErrorCode status = MatSetNearNullSpace(matrix, null_space);
+  MatNullSpaceDestroy(&null_space);
+  COAPT_PETSC_CHECK(status);
+}
+
 std::vector<PetscInt> boundary_dofs(const mesh::Mesh& mesh, int n_components, int tag,
                                     std::span<const int> components) {
   std::vector<int> all(static_cast<std::size_t>(n_components));

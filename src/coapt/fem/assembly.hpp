@@ -118,6 +118,10 @@ std::vector<PetscInt> boundary_dofs(const mesh::Mesh& mesh, int n_components, in
 /// removed columns. `values` is a vector with the boundary values at those dofs. Collective.
 void apply_dirichlet(Mat matrix, Vec rhs, std::span<const PetscInt> dofs, Vec values);
 
+/// Gives `matrix` (a vector problem with mesh.dim components per vertex) the rigid-body modes
+/// of the mesh as its near-null space (3 in 2D, 6 in 3D), which GAMG uses. Collective.
+void set_rigid_body_modes(const mesh::Mesh& mesh, Mat matrix);
+
 // ---------------------------------------------------------------------------------------
 
 void add_local_to_global(Vec vector);  // reverse ghost scatter with ADD (internal helper)

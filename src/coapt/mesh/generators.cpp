@@ -380,7 +380,7 @@ Mesh unstructured_box(double x0, double y0, double z0, double x1, double y1, dou
   return generate_with_gmsh(session, 3, lo, hi, h);
 }
 
-Mesh mesh_geo_file(const std::string& path, double h) {
+Mesh mesh_geo_file(const std::string& path, double h, double size_factor) {
   namespace fs = std::filesystem;
   std::error_code error;
   const auto status = fs::status(path, error);
@@ -399,6 +399,7 @@ Mesh mesh_geo_file(const std::string& path, double h) {
     gmsh::model::mesh::getElementTypes(types);
     if (!types.empty()) gmsh::model::mesh::clear();  // the file meshed itself: redo it
     gmsh::option::setNumber("Mesh.MeshSizeMax", h);
+    gmsh::option::setNumber("Mesh.MeshSizeFactor", size_factor);
     const int dim = gmsh::model::getDimension();
     if (dim < 2) throw InputError(path + ": the geometry has no surfaces or volumes to mesh");
     double lo[3], hi[3];

@@ -53,7 +53,7 @@ struct Mesh {
   std::int64_t n_global_cells = 0;
 
   // Boundary facets (segments in 2D, triangles in 3D)
-  std::vector<int> facets;      ///< n_facets × dim local vertex indices
+  std::vector<int> facets;      ///< n_facets × dim local vertex indices (normal out of facet_cell)
   std::vector<int> facet_tags;  ///< physical tag of each facet
   std::vector<int> facet_cell;  ///< local cell each facet bounds
 

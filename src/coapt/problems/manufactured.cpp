@@ -233,7 +233,7 @@ class Manufactured final : public run::Problem {
 
     fem::LinearSolver solver(comm_, name_ + "_",
                              {n == 1 ? "cg" : "cg", "gamg", 1e-12, 1e-50, 2000});
-    if (n > 1) set_rigid_body_modes(matrix.mat());
+    if (n > 1) fem::set_rigid_body_modes(mesh_, matrix.mat());
     solver.set_operator(matrix.mat());
     fem::SolveStats stats;
     {
@@ -320,22 +320,6 @@ class Manufactured final : public run::Problem {
     for (const auto& group : mesh_.groups)
       if (group.dim == mesh_.dim - 1) names += (names.empty() ? "" : ", ") + group.name;
     return names.empty() ? "it has none" : "it has: " + names;
-  }
-
-  /// Rigid-body modes as the near-null space for GAMG (3 in 2D, 6 in 3D).
-  void set_rigid_body_modes(Mat matrix) {
-    auto coordinates = fem::create_vertex_vector(mesh_, mesh_.dim);
-    PetscScalar* data = nullptr;
-    COAPT_PETSC_CHECK(VecGetArray(coordinates, &data));
-    std::copy(
-        mesh_.coordinates.begin(),
-        mesh_.coordinates.begin() + static_cast<std::ptrdiff_t>(mesh_.n_owned_vertices) * mesh_.dim,
-        data);
-    COAPT_PETSC_CHECK(VecRestoreArray(coordinates, &data));
-    MatNullSpace null_space = nullptr;
-    COAPT_PETSC_CHECK(MatNullSpaceCreateRigidBody(coordinates, &null_space));
-    COAPT_PETSC_CHECK(MatSetNearNullSpace(matrix, null_space));
-    COAPT_PETSC_CHECK(MatNullSpaceDestroy(&null_space));
   }
 
   std::string name_;

@@ -1,6 +1,8 @@
 #include "coapt/run/problem.hpp"
 
+#include "coapt/fluid/flow_problem.hpp"
 #include "coapt/problems/manufactured.hpp"
+#include "coapt/solid/solid_problem.hpp"
 
 namespace coapt::run {
 
@@ -11,6 +13,10 @@ const std::vector<ProblemKind>& problem_kinds() {
       {"elasticity",
        "linear elasticity with a manufactured solution (verification of the FEM core)",
        problems::create_elasticity},
+      {"solid", "quasi-static finite-strain solids (P1, total Lagrangian)",
+       solid::create_solid_problem},
+      {"navier_stokes", "incompressible Navier-Stokes, P1-P1 SUPG/PSPG/LSIC",
+       fluid::create_flow_problem},
   };
   return kinds;
 }

@@ -1,0 +1,107 @@
+#pragma once
+/// @file navier_stokes.hpp
+/// The fluid operator: P1-P1 SUPG/PSPG/LSIC Navier–Stokes (kernels.hpp) on a distributed
+/// mesh, solved by Newton's method for one steady problem or one BDF step. It is the only
+/// fluid file that touches PETSc solvers (options prefix -fluid_).
+///
+/// State: one ghosted vector with (u_1, .., u_Dim, p) per vertex (fem::create_vertex_vector
+/// with n = dim + 1). Dirichlet dofs take the values the caller wrote into the state before
+/// solve(); Newton corrections are zero there. Constrained vertices (the immersed coupling's
+/// velocity constraint) are Dirichlet velocity dofs whose reaction forces can be read back.
+
+#include <mpi.h>
+#include <petscvec.h>
+
+#include <array>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "coapt/core/petsc.hpp"
+#include "coapt/fem/assembly.hpp"
+#include "coapt/fem/linear_solver.hpp"
+#include "coapt/mesh/mesh.hpp"
+
+namespace coapt::fluid {
+
+/// Material, stabilisation and Newton settings (read once by the driver).
+struct FluidParameters {
+  double density = 1.0;                      ///< ρ [kg/m³]
+  double viscosity = 1.0;                    ///< dynamic viscosity μ [Pa s]
+  bool convection = true;                    ///< false: Stokes
+  double c_inverse = 9.0;                    ///< C_I of τ_M (kernels.hpp)
+  double newton_relative_tolerance = 1e-8;   ///< ‖R‖ ≤ rtol ‖R₀‖ ...
+  double newton_absolute_tolerance = 1e-10;  ///< ... or ‖R‖ ≤ atol
+  int newton_max_iterations = 25;
+};
+
+/// The time discretisation of one solve: steady (time_step ≤ 0) or a BDF step with
+/// u̇ = (α₀ uⁿ⁺¹ + α₁ uⁿ + α₂ uⁿ⁻¹)/Δt.
+struct TimeLevel {
+  double time_step = 0;           ///< Δt [s] (≤ 0: steady)
+  std::array<double, 3> alpha{};  ///< α₀, α₁, α₂
+  Vec previous = nullptr;         ///< uⁿ (state vector; unused when steady)
+  Vec before_previous = nullptr;  ///< uⁿ⁻¹ (may be null when α₂ = 0)
+};
+
+/// What one Newton solve did.
+struct NewtonReport {
+  int iterations = 0;
+  int linear_iterations = 0;             ///< summed over the Newton steps
+  std::vector<double> residual_history;  ///< ‖R‖ of the free dofs, one per iterate
+};
+
+/// The discrete Navier–Stokes operator on one mesh. Every call is collective on mesh.comm.
+class NavierStokes {
+ public:
+  /// Sets up pattern, vectors and the linear solver. `mesh` must outlive the operator.
+  NavierStokes(const mesh::Mesh& mesh, const FluidParameters& parameters);
+
+  /// The state vector (u, p interleaved, ghosted); write Dirichlet values into it.
+  Vec state() const { return state_.get(); }
+  /// Number of components per vertex (dim + 1).
+  int n_components() const { return mesh_.dim + 1; }
+
+  /// Replaces the Dirichlet dofs (owned global dof numbers, any order).
+  void set_dirichlet_dofs(std::vector<PetscInt> dofs);
+  /// Constrains the velocity at owned local vertices `vertices` to `velocities`
+  /// (vertices.size() × dim, row-major) [m/s]; replaces the previous constraint. The state is
+  /// updated at those dofs; the matrix pattern stays fixed.
+  void set_velocity_constraint(std::span<const int> vertices, std::span<const double> velocities);
+
+  /// Newton's method to the tolerances of FluidParameters; throws ConvergenceError with the
+  /// residual history when it fails or meets a non-finite residual. `label` names the step.
+  NewtonReport solve(const TimeLevel& time, const std::string& label);
+
+  /// Force exerted by the fluid on the boundary group with facet tag `tag` [N/m in 2D, N in
+  /// 3D], computed variationally: F_i = −R(u_h, p_h; w = e_i χ_Γ) with χ_Γ the P1 indicator of
+  /// the group's vertices and R the full (stabilised) momentum residual at the current state.
+  std::vector<double> boundary_force(int tag, const TimeLevel& time);
+  /// Reaction forces at the constrained vertices (same order and layout as the velocities
+  /// given to set_velocity_constraint): the force the fluid exerts on the constraint, −R at
+  /// those velocity dofs (R = the force the constraint applies to the fluid) [N/m or N].
+  std::vector<double> constraint_reactions(const TimeLevel& time);
+
+  /// The linear solver's description ("gmres + lu (options prefix -fluid_)").
+  std::string describe_solver() const { return solver_.describe(); }
+
+ private:
+  template <int Dim>
+  void assemble(const TimeLevel& time, bool with_matrix);
+  /// Residual of the current state into residual_ (no Dirichlet rows removed).
+  void assemble_residual(const TimeLevel& time);
+  void assemble_system(const TimeLevel& time);
+  /// ‖R‖ over the free dofs (a copy with Dirichlet rows zeroed goes into free_residual_).
+  double free_residual_norm();
+  std::vector<PetscInt> all_fixed_dofs() const;
+
+  const mesh::Mesh& mesh_;
+  const FluidParameters parameters_;
+  fem::P1Matrix matrix_;
+  OwnedVec state_, residual_, free_residual_, correction_;
+  fem::LinearSolver solver_;
+  std::vector<PetscInt> dirichlet_dofs_;
+  std::vector<int> constrained_vertices_;
+};
+
+}  // namespace coapt::fluid

@@ -1,0 +1,224 @@
+// Reading the `problem: solid` case sections (see solid_parameters.hpp for the format).
+#include "coapt/solid/solid_parameters.hpp"
+
+#include <fmt/format.h>
+
+#include "coapt/core/error.hpp"
+
+namespace coapt::solid {
+
+using config::Bounds;
+
+namespace {
+
+// "file:line: path" of a key, the prefix of every message about it.
+std::string located(const config::Section& section, std::string_view key = "") {
+  const std::string path =
+      key.empty()
+          ? section.path()
+          : (section.path().empty() ? std::string(key) : section.path() + "." + std::string(key));
+  return fmt::format("{}: {}", section.where(key), path);
+}
+
+int component_index(const config::Section& section, const std::string& name) {
+  if (name == "x") return 0;
+  if (name == "y") return 1;
+  if (name == "z") return 2;
+  section.fail("components", fmt::format("unknown component '{}' (use x, y, z)", name));
+}
+
+Vector3 read_direction(const config::Section& section, std::string_view key) {
+  const auto values =
+      section.get<std::vector<double>>(key, {}, {"", "unit fibre direction (reference)"});
+  if (values.size() < 2 || values.size() > 3)
+    section.fail(key, "expected 2 or 3 components (a 2D direction gets z = 0)");
+  Vector3 direction = Vector3::Zero();
+  for (std::size_t i = 0; i < values.size(); ++i) direction(static_cast<int>(i)) = values[i];
+  return direction;
+}
+
+}  // namespace
+
+Material read_material(const config::Section& section) {
+  const std::string model =
+      section.choice("model", "",
+                     {"linear_elastic", "saint_venant_kirchhoff", "neo_hookean",
+                      "nearly_incompressible_neo_hookean", "fibre_reinforced"},
+                     {"", "constitutive law"});
+  const std::string where = located(section);
+  // Elastic constants: (young_modulus, poisson_ratio) or (shear_modulus with one of
+  // poisson_ratio, lambda, bulk_modulus); the rest follows from the isotropic relations
+  // λ = 2μν/(1 − 2ν), κ = λ + 2μ/3.
+  const bool has_young = section.has("young_modulus");
+  const bool has_shear = section.has("shear_modulus");
+  if (has_young == has_shear)
+    section.fail("", "give either young_modulus or shear_modulus (exactly one)");
+  double mu = 0, lambda = 0;
+  if (has_young) {
+    const double young =
+        section.require<double>("young_modulus", {"Pa", "Young's modulus E", Bounds::positive()});
+    const double poisson =
+        section.require<double>("poisson_ratio", {"", "Poisson's ratio", Bounds::open(-1.0, 0.5)});
+    const LameParameters lame = lame_from_young_poisson(young, poisson, where);
+    mu = lame.mu;
+    lambda = lame.lambda;
+  } else {
+    mu = section.require<double>("shear_modulus", {"Pa", "shear modulus μ", Bounds::positive()});
+    const int given = int(section.has("poisson_ratio")) + int(section.has("lambda")) +
+                      int(section.has("bulk_modulus"));
+    if (given != 1)
+      section.fail("shear_modulus",
+                   "with shear_modulus give exactly one of poisson_ratio, lambda, bulk_modulus");
+    if (section.has("poisson_ratio")) {
+      const double poisson = section.require<double>(
+          "poisson_ratio", {"", "Poisson's ratio", Bounds::open(-1.0, 0.5)});
+      lambda = 2.0 * mu * poisson / (1.0 - 2.0 * poisson);
+    } else if (section.has("lambda")) {
+      lambda = section.require<double>("lambda", {"Pa", "first Lamé constant λ"});
+    } else {
+      lambda =
+          section.require<double>("bulk_modulus", {"Pa", "bulk modulus κ", Bounds::positive()}) -
+          2.0 / 3.0 * mu;
+    }
+  }
+  const double bulk = lambda + 2.0 / 3.0 * mu;
+  Material material;
+  if (model == "linear_elastic")
+    material = LinearElastic{lambda, mu};
+  else if (model == "saint_venant_kirchhoff")
+    material = SaintVenantKirchhoff{lambda, mu};
+  else if (model == "neo_hookean")
+    material = NeoHookean{lambda, mu};
+  else if (model == "nearly_incompressible_neo_hookean")
+    material = NearlyIncompressibleNeoHookean{mu, bulk};
+  else {
+    FibreReinforced law;
+    law.shear_modulus = mu;
+    law.bulk_modulus = bulk;
+    law.fibre_k1 =
+        section.require<double>("fibre_k1", {"Pa", "fibre stiffness k1", Bounds::non_negative()});
+    law.fibre_k2 =
+        section.get<double>("fibre_k2", 0.0, {"", "fibre stiffening k2", Bounds::non_negative()});
+    law.n_fibre_families = section.get<int>("fibre_families", 1,
+                                            {"", "number of fibre families", Bounds::closed(1, 2)});
+    material = law;
+  }
+  validate(material, where);
+  return material;
+}
+
+SolidParameters SolidParameters::read(const config::Section& root) {
+  SolidParameters p;
+  p.mesh = mesh::MeshInput::read(root.section("mesh", "the mesh"), root.case_directory());
+
+  const auto bodies = root.sections("bodies", "the solid bodies (cell groups with a material)");
+  if (bodies.empty()) root.fail("bodies", "at least one body is required");
+  int catch_all = 0;
+  for (const auto& section : bodies) {
+    BodyParameters body;
+    body.where = located(section);
+    body.name = section.get<std::string>("name", "body", {"", "name of the body"});
+    body.cell_groups = section.get<std::vector<std::string>>(
+        "cell_groups", {}, {"", "mesh cell groups of the body (empty: all remaining cells)"});
+    if (body.cell_groups.empty() && ++catch_all > 1)
+      section.fail("cell_groups", "only one body may omit cell_groups");
+    body.density = section.get<double>("density", 0.0,
+                                       {"kg/m^3", "reference density", Bounds::non_negative()});
+    body.material = read_material(section.section("material", "constitutive law"));
+    if (const auto* fibre_law = std::get_if<FibreReinforced>(&body.material)) {
+      body.fibres.a0[0] = read_direction(section, "fibre_direction");
+      if (fibre_law->n_fibre_families > 1)
+        body.fibres.a0[1] = read_direction(section, "second_fibre_direction");
+      validate_fibres(body.material, body.fibres, body.where);
+    }
+    p.bodies.push_back(std::move(body));
+  }
+
+  for (const auto& section : root.sections("dirichlet", "prescribed displacements")) {
+    DirichletParameters condition;
+    condition.where = located(section);
+    condition.boundary = section.require<std::string>("boundary", {"", "boundary group"});
+    const auto names = section.get<std::vector<std::string>>(
+        "components", {}, {"", "prescribed components x, y, z (empty: all)"});
+    for (const auto& name : names) condition.components.push_back(component_index(section, name));
+    condition.values = section.get<std::vector<double>>(
+        "displacement", {}, {"m", "final displacement per listed component (empty: zero)"});
+    if (!condition.values.empty() && !names.empty() && condition.values.size() != names.size())
+      section.fail("displacement", "expected one value per entry of components");
+    p.dirichlet.push_back(std::move(condition));
+  }
+  if (p.dirichlet.empty())
+    root.fail("dirichlet",
+              "at least one Dirichlet condition is required (a static solid needs "
+              "its rigid motions fixed)");
+
+  for (const auto& section : root.sections("tractions", "dead loads on boundary groups")) {
+    TractionParameters load;
+    load.where = located(section);
+    load.boundary = section.require<std::string>("boundary", {"", "boundary group"});
+    const bool has_traction = section.has("traction"), has_total = section.has("total_force");
+    if (has_traction == has_total)
+      section.fail("", "give either traction or total_force (exactly one)");
+    load.total = has_total;
+    load.vector = has_total ? section.require<std::vector<double>>(
+                                  "total_force", {"N", "total force, spread uniformly (N/m in 2D)"})
+                            : section.require<std::vector<double>>(
+                                  "traction", {"Pa", "force per reference area (length in 2D)"});
+    p.tractions.push_back(std::move(load));
+  }
+
+  p.gravity = root.get<std::vector<double>>("gravity", {}, {"m/s^2", "gravity (body force ρ g)"});
+  p.gravity_where = located(root, "gravity");
+  p.steps = root.get<int>("steps", 1, {"", "load steps", Bounds::closed(1, 100000)});
+
+  auto newton = root.section("newton", "Newton's method per load step");
+  p.newton.relative_tolerance =
+      newton.get<double>("relative_tolerance", 1e-9,
+                         {"", "stop when |R| <= rtol |R0| (free dofs)", Bounds::open(0.0, 1.0)});
+  p.newton.absolute_tolerance = newton.get<double>(
+      "absolute_tolerance", 0.0, {"N", "or when |R| <= atol (N/m in 2D)", Bounds::non_negative()});
+  p.newton.update_tolerance = newton.get<double>(
+      "update_tolerance", 1e-12,
+      {"", "or when |du| <= dtol |u| (round-off floor of R)", Bounds::closed(0.0, 1e-3)});
+  p.newton.max_iterations = newton.get<int>(
+      "max_iterations", 25, {"", "iterations per load step", Bounds::closed(1, 1000)});
+
+  for (const auto& section : root.sections("probes", "points where the displacement is reported")) {
+    ProbeParameters probe;
+    probe.where = located(section);
+    probe.name = section.require<std::string>("name", {"", "name in series.csv and summary.json"});
+    probe.point = section.require<std::vector<double>>("point", {"m", "reference coordinates"});
+    p.probes.push_back(std::move(probe));
+  }
+
+  auto output = root.section("output", "what the run writes");
+  p.write_vtk = output.get<bool>("vtk", true, {"", "write displacement and stresses as VTK"});
+  return p;
+}
+
+void SolidParameters::check_dimension(int dim) const {
+  const auto check = [dim](std::size_t size, const std::string& where, const char* what) {
+    if (static_cast<int>(size) != dim)
+      throw InputError(
+          fmt::format("{}: {} has {} entries, the mesh has dimension {}", where, what, size, dim));
+  };
+  for (const auto& condition : dirichlet) {
+    for (int component : condition.components)
+      if (component >= dim)
+        throw InputError(fmt::format("{}: component z in a 2D mesh", condition.where));
+    if (condition.components.empty() && !condition.values.empty())
+      check(condition.values.size(), condition.where, "displacement");
+  }
+  for (const auto& load : tractions) check(load.vector.size(), load.where, "the load vector");
+  if (!gravity.empty()) check(gravity.size(), gravity_where, "gravity");
+  for (const auto& probe : probes) check(probe.point.size(), probe.where, "point");
+  if (dim == 2)
+    for (const auto& body : bodies)
+      if (std::holds_alternative<FibreReinforced>(body.material))
+        for (const auto& a0 : body.fibres.a0)
+          if (a0.z() != 0.0)
+            throw InputError(
+                fmt::format("{}: plane strain needs fibres in the x-y plane", body.where));
+}
+
+}  // namespace coapt::solid

@@ -1,0 +1,339 @@
+#pragma once
+/// @file search.hpp
+/// Parallel search of the element pairs of the variational transfer (stages 1–2 of the
+/// pipeline; the local integrals are intersection.hpp, the operators operators.hpp).
+///
+/// The slave mesh S (the fluid: it carries the multiplier) and the master mesh M (the solid)
+/// are distributed over the same communicator independently: any partition, not aligned.
+/// Every pair (owned slave cell, master cell) whose intersection may have positive measure is
+/// found on the rank that owns the slave cell, so each pair is seen exactly once.
+///
+///  Stage 1, MasterExchange: every rank publishes (allgather) the bounding box of its owned
+///    slave cells and of its owned master cells. Each rank sends every owned master cell
+///    (vertex coordinates and global vertex numbers) to each rank whose slave box overlaps
+///    the cell's box, and receives the master cells it needs, from the ranks whose master box
+///    overlaps its slave box only (point-to-point, no all-to-all). Vertices are sent once per
+///    destination and merged on arrival (received vertices sorted by global number).
+///  Stage 2, BoxGrid + PairSearch: a uniform grid over the received master cells' boxes; for
+///    each owned slave cell the grid yields the master cells whose box overlaps the slave
+///    cell's box, and a separating-plane test (the intersection kernel's own first test, with
+///    the same tolerance, so it never drops a pair the kernel would keep) discards most of
+///    the box overlaps that do not intersect. The pairs are stored grouped by slave cell.
+///
+/// Moving master (the solid moves through a fixed fluid mesh): the search is built with the
+/// master boxes inflated by `SearchOptions::margin`. While no master vertex has moved more
+/// than the margin (per coordinate) from where it was at the last full search, the exchange
+/// pattern and the grid stay valid (Verlet-list argument: every current box lies inside its
+/// inflated reference box), so update_master() only re-sends the coordinates along the
+/// existing pattern, re-makes the master simplices and re-runs the per-slave-cell queries.
+/// Past the margin (on any rank) it redoes the whole search. The slave never moves here; if
+/// it does, build a new PairSearch.
+///
+/// Memory per rank: received master cells (dim + 1 ints) and vertices (global number and
+/// coordinates), one Simplex per received master cell, the grid (a few ints per received
+/// cell), one int per pair, and three ints per owned slave cell.
+
+#include <mpi.h>
+#include <petscsys.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <vector>
+
+#include "coapt/mesh/mesh.hpp"
+#include "coapt/transfer/geometry.hpp"
+
+namespace coapt::transfer {
+
+/// A closed axis-aligned box; empty when lower > upper on some axis.
+template <int dim>
+struct Box {
+  Point<dim> lower;
+  Point<dim> upper;
+
+  static Box empty() {
+    Box b;
+    b.lower.fill(std::numeric_limits<double>::infinity());
+    b.upper.fill(-std::numeric_limits<double>::infinity());
+    return b;
+  }
+  static Box of(const Simplex<dim>& s) { return Box{s.box_lower, s.box_upper}; }
+  bool is_empty() const {
+    for (int k = 0; k < dim; ++k)
+      if (!(lower[k] <= upper[k])) return true;
+    return false;
+  }
+  void include(const Point<dim>& p) {
+    for (int k = 0; k < dim; ++k) {
+      lower[k] = std::min(lower[k], p[k]);
+      upper[k] = std::max(upper[k], p[k]);
+    }
+  }
+  void include(const Box& other) {
+    for (int k = 0; k < dim; ++k) {
+      lower[k] = std::min(lower[k], other.lower[k]);
+      upper[k] = std::max(upper[k], other.upper[k]);
+    }
+  }
+  Box inflated(double margin) const {
+    Box b = *this;
+    for (int k = 0; k < dim; ++k) {
+      b.lower[k] -= margin;
+      b.upper[k] += margin;
+    }
+    return b;
+  }
+  /// Closed boxes: touching counts as overlapping (as in the intersection kernel's test).
+  bool overlaps(const Box& other) const {
+    for (int k = 0; k < dim; ++k)
+      if (upper[k] < other.lower[k] || other.upper[k] < lower[k]) return false;
+    return true;
+  }
+  bool contains(const Box& other) const {
+    for (int k = 0; k < dim; ++k)
+      if (other.lower[k] < lower[k] || upper[k] < other.upper[k]) return false;
+    return true;
+  }
+};
+
+/// The simplex of local cell `c` of `mesh` (make_simplex on its vertex coordinates).
+template <int dim>
+Simplex<dim> cell_simplex(const mesh::Mesh& mesh, int c) {
+  std::array<Point<dim>, dim + 1> vertices;
+  const int* cell = mesh.cells.data() + static_cast<std::size_t>(c) * (dim + 1);
+  for (int v = 0; v <= dim; ++v) {
+    const double* x = mesh.coordinates.data() + static_cast<std::size_t>(cell[v]) * dim;
+    for (int k = 0; k < dim; ++k) vertices[v][k] = x[k];
+  }
+  return make_simplex<dim>(vertices);
+}
+
+/// Bounding box of the owned cells of `mesh` (empty if it owns none).
+template <int dim>
+Box<dim> owned_cells_box(const mesh::Mesh& mesh);
+
+/// True when some face plane of `a` or of `b` separates them, with the intersection kernel's
+/// tolerance and arithmetic (all λ ≤ kPlaneTolerance): such pairs have an intersection of zero
+/// measure and local_integrals() returns false for them. The converse does not hold (3D pairs
+/// separated only by an edge–edge plane pass), so this is a conservative filter. Degenerate
+/// simplices count as separated.
+template <int dim>
+bool separated_by_face_plane(const Simplex<dim>& a, const Simplex<dim>& b);
+
+// ------------------------------------------------------------------------------------------
+// Stage 1: exchange of master cells
+// ------------------------------------------------------------------------------------------
+
+/// The master cells a rank received (its own included, when they overlap its slave box).
+template <int dim>
+struct ReceivedMaster {
+  std::vector<PetscInt> vertex_global;  ///< master global vertex number, ascending, unique
+  std::vector<double> coordinates;      ///< per received vertex, dim values [m]
+  std::vector<int> cells;               ///< per received cell, dim + 1 received-vertex indices
+  std::vector<int> source_rank;         ///< rank that owns each received cell
+  std::vector<int> source_cell;         ///< its local (owned) cell index on that rank
+
+  int n_cells() const { return static_cast<int>(source_rank.size()); }
+  int n_vertices() const { return static_cast<int>(vertex_global.size()); }
+  /// Simplex of received cell `c` from the current coordinates.
+  Simplex<dim> simplex(int c) const {
+    std::array<Point<dim>, dim + 1> vertices;
+    for (int v = 0; v <= dim; ++v) {
+      const double* x =
+          coordinates.data() +
+          static_cast<std::size_t>(cells[static_cast<std::size_t>(c) * (dim + 1) + v]) * dim;
+      for (int k = 0; k < dim; ++k) vertices[v][k] = x[k];
+    }
+    return make_simplex<dim>(vertices);
+  }
+};
+
+/// Stage 1: sends owned master cells to the ranks whose slave box they overlap.
+template <int dim>
+class MasterExchange {
+ public:
+  /// Full exchange over `comm` (master.comm or a duplicate of it). `slave_boxes` holds every
+  /// rank's owned-slave-cell box (index = rank); an owned master cell goes to rank r when its
+  /// box inflated by `margin` overlaps slave_boxes[r]. Collective.
+  void exchange(const mesh::Mesh& master, MPI_Comm comm, std::span<const Box<dim>> slave_boxes,
+                double margin);
+  /// Re-sends the current coordinates of the same vertices to the same ranks (the master
+  /// moved, its mesh and partition did not). Collective.
+  void refresh(const mesh::Mesh& master);
+  const ReceivedMaster<dim>& received() const { return received_; }
+  /// Master cells this rank sent in the last full exchange (counting repeats per rank).
+  std::int64_t n_sent_cells() const { return n_sent_cells_; }
+
+ private:
+  MPI_Comm comm_ = MPI_COMM_NULL;
+  // send side: per destination, the local master vertices it gets (in message order)
+  std::vector<int> send_ranks_;
+  std::vector<int> send_offsets_;   ///< into send_vertices_, send_ranks_.size() + 1
+  std::vector<int> send_vertices_;  ///< local master vertex indices
+  // receive side: per source, where each incoming vertex goes in received_
+  std::vector<int> recv_ranks_;
+  std::vector<int> recv_offsets_;   ///< into recv_position_, recv_ranks_.size() + 1
+  std::vector<int> recv_position_;  ///< received-vertex index of each incoming vertex
+  std::int64_t n_sent_cells_ = 0;
+  ReceivedMaster<dim> received_;
+};
+
+// ------------------------------------------------------------------------------------------
+// Stage 2: local acceleration structure and pair list
+// ------------------------------------------------------------------------------------------
+
+/// A uniform grid of bins over a set of boxes; each box is listed in every bin it overlaps.
+/// Queries need no scratch state (a box met in several bins is reported from one bin only:
+/// the first bin of the overlap of its bin range with the query's), so they are const and
+/// thread-safe.
+template <int dim>
+class BoxGrid {
+ public:
+  /// Bins `boxes` (empty boxes are left out). The bin size is the mean box extent per axis,
+  /// enlarged when needed to keep at most about 2 bins per box. Linear time.
+  void build(std::span<const Box<dim>> boxes);
+  /// Calls visit(i) once for each box i that overlaps `query` (closed boxes).
+  template <class Visit>
+  void query(const Box<dim>& query, Visit&& visit) const;
+  std::size_t n_bins() const { return bin_offsets_.empty() ? 0 : bin_offsets_.size() - 1; }
+  std::size_t memory_bytes() const {
+    return boxes_.capacity() * sizeof(Box<dim>) + bin_offsets_.capacity() * sizeof(int) +
+           bin_entries_.capacity() * sizeof(int);
+  }
+
+ private:
+  int bin_coordinate(double x, int axis) const {
+    const double t = (x - origin_[axis]) * inverse_size_[axis];
+    if (!(t > 0.0)) return 0;  // also NaN
+    return t >= counts_[axis] ? counts_[axis] - 1 : static_cast<int>(t);
+  }
+
+  Point<dim> origin_{};
+  Point<dim> inverse_size_{};
+  std::array<int, dim> counts_{};
+  std::vector<Box<dim>> boxes_;
+  std::vector<int> bin_offsets_;
+  std::vector<int> bin_entries_;
+};
+
+/// Options of the pair search.
+struct SearchOptions {
+  /// Master boxes are inflated by this much [m] in the exchange and in the grid, so the
+  /// search stays valid while no master vertex moves farther (per coordinate) from where it
+  /// was at the last full search. 0 for a fixed master.
+  double margin = 0.0;
+};
+
+/// What the last search (or update) did, on this rank.
+struct SearchStatistics {
+  bool full = true;                    ///< full search (false: pattern and grid reused)
+  std::int64_t sent_master_cells = 0;  ///< owned master cells sent (repeats per rank counted)
+  std::int64_t received_master_cells = 0;
+  std::int64_t candidate_pairs =
+      0;                        ///< (owned slave cell, received master cell) with boxes overlapping
+  std::int64_t pairs = 0;       ///< kept after the separating-plane filter
+  double exchange_seconds = 0;  ///< stage 1 (boxes, messages, merge) or coordinate refresh
+  double grid_seconds = 0;      ///< master simplices and grid
+  double query_seconds = 0;     ///< slave simplices, grid queries, filter
+  std::size_t memory_bytes = 0;  ///< received data, simplices, grid and pairs
+};
+
+/// Stages 1 and 2: the pairs (owned slave cell, received master cell) to integrate.
+template <int dim>
+class PairSearch {
+ public:
+  /// Full search. Both meshes must be distributed over the same communicator (or both be
+  /// whole serial meshes), have dimension dim, and outlive this object (the slave is read
+  /// again by update_master). Collective.
+  PairSearch(const mesh::Mesh& slave, const mesh::Mesh& master, const SearchOptions& options = {});
+  PairSearch(const PairSearch&) = delete;
+  PairSearch& operator=(const PairSearch&) = delete;
+  ~PairSearch();
+
+  /// The master's coordinates changed (owned and ghost vertices, same cells and partition):
+  /// reuses the exchange pattern and the grid if every master vertex stayed within the margin
+  /// of its position at the last full search, else searches again. Returns true when reused.
+  /// Collective.
+  bool update_master(const mesh::Mesh& master);
+
+  const mesh::Mesh& slave() const { return *slave_; }
+  const ReceivedMaster<dim>& master() const { return exchange_.received(); }
+  /// Simplex of each received master cell (current coordinates).
+  std::span<const Simplex<dim>> master_simplices() const { return master_simplices_; }
+  /// The received master cells paired with owned slave cell c.
+  std::span<const int> pairs_of(int c) const {
+    const CellPairs& p = cell_pairs_[static_cast<std::size_t>(c)];
+    return {pair_chunks_[static_cast<std::size_t>(p.chunk)].data() + p.start,
+            static_cast<std::size_t>(p.count)};
+  }
+  /// Number of pairs (over all owned slave cells).
+  std::int64_t n_pairs() const { return statistics_.pairs; }
+  const SearchStatistics& statistics() const { return statistics_; }
+  /// A duplicate of the meshes' communicator, private to this search.
+  MPI_Comm comm() const { return comm_; }
+
+ private:
+  void full_search();
+  void build_grid();
+  void query_pairs();
+  double master_displacement() const;  // local max |x − x_ref|_∞ over owned cells' vertices
+
+  const mesh::Mesh* slave_;
+  const mesh::Mesh* master_;
+  SearchOptions options_;
+  MPI_Comm comm_ = MPI_COMM_NULL;
+  MasterExchange<dim> exchange_;
+  std::vector<Simplex<dim>> master_simplices_;
+  BoxGrid<dim> grid_;
+  std::vector<double> reference_coordinates_;  ///< master local coordinates at the last full search
+  // Pairs in chunks of about kChunk ints (a cell's pairs never straddle two chunks): no
+  // doubling copy while the list grows, and the chunks are reused by the next search.
+  static constexpr std::size_t kChunk = std::size_t{1} << 20;
+  struct CellPairs {
+    int chunk = 0, start = 0, count = 0;
+  };
+  std::vector<CellPairs> cell_pairs_;
+  std::vector<std::vector<int>> pair_chunks_;
+  std::vector<int> scratch_;  ///< one cell's pairs while it is searched
+  SearchStatistics statistics_;
+};
+
+// ------------------------------------------------------------------------------------------
+
+template <int dim>
+template <class Visit>
+void BoxGrid<dim>::query(const Box<dim>& query, Visit&& visit) const {
+  if (boxes_.empty() || query.is_empty()) return;
+  std::array<int, dim> lo, hi;
+  for (int k = 0; k < dim; ++k) {
+    lo[k] = bin_coordinate(query.lower[k], k);
+    hi[k] = bin_coordinate(query.upper[k], k);
+  }
+  std::array<int, dim> bin = lo;
+  while (true) {
+    int index = 0;
+    for (int k = dim - 1; k >= 0; --k) index = index * counts_[k] + bin[k];
+    for (int e = bin_offsets_[index]; e < bin_offsets_[index + 1]; ++e) {
+      const int i = bin_entries_[e];
+      const Box<dim>& box = boxes_[i];
+      if (!box.overlaps(query)) continue;
+      // report from the first bin of the overlap of the two bin ranges only
+      bool first = true;
+      for (int k = 0; k < dim && first; ++k)
+        first = bin[k] == std::max(lo[k], bin_coordinate(box.lower[k], k));
+      if (first) visit(i);
+    }
+    int k = 0;
+    while (k < dim && bin[k] == hi[k]) {
+      bin[k] = lo[k];
+      ++k;
+    }
+    if (k == dim) break;
+    ++bin[k];
+  }
+}
+
+}  // namespace coapt::transfer
