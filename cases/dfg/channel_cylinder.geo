@@ -2,8 +2,8 @@
 // centred at (0.2, 0.2). Physical groups: inlet (x = 0), outlet (x = 2.2), walls (y = 0 and
 // y = 0.41), cylinder, fluid. The point sizes refine the mesh near the cylinder: lc_body there,
 // lc_far (which the case's mesh.size caps through Mesh.MeshSizeMax) on the channel corners;
-// Gmsh grades the size in between. The cylinder size does not follow mesh.level: levels whose
-// size falls below lc_body are uniform.
+// Gmsh grades the size in between. Each mesh.level halves every size (Mesh.MeshSizeFactor),
+// the cylinder's included.
 lc_far = 1.0;
 lc_body = 0.005;
 r = 0.05;

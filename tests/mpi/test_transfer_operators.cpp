@@ -62,7 +62,7 @@ struct Configuration {
 std::vector<Configuration> configurations() {
   return {
       {"rotated cube inside (3D)",
-       [] { return coapt::mesh::structured_box(0, 0, 0, 1, 1, 1, 8, 8, 8); },
+       [] { return coapt::mesh::structured_box(0, 0, 0, 1, 1, 1, 10, 10, 10); },
        [] {
          Mesh m = coapt::mesh::structured_box(0.25, 0.25, 0.25, 0.75, 0.75, 0.75, 6, 6, 6);
          rotate(m, 0.7, {1, 2, 3});

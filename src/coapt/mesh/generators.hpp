@@ -62,8 +62,8 @@ Mesh unstructured_box(double x0, double y0, double z0, double x1, double y1, dou
 /// sizes (characteristic lengths at points, size fields); the file's other options
 /// (Mesh.MeshSizeFactor, ...) apply. Mesh.ElementOrder must stay 1. A mesh the file already
 /// generated itself ("Mesh 2;") is discarded and redone at size h. `size_factor` multiplies
-/// every size the file sets (Gmsh's Mesh.MeshSizeFactor): refinement levels pass h / 2^level
-/// and 2^-level, so local refinement (near a cylinder, say) follows the level too.
+/// every size after the cap h (Gmsh's Mesh.MeshSizeFactor): refinement levels pass the
+/// level-0 h and 2^-level, so every size, local refinement included, halves per level.
 Mesh mesh_geo_file(const std::string& path, double h, double size_factor = 1.0);
 
 }  // namespace coapt::mesh

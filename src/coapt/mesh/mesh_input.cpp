@@ -95,7 +95,9 @@ Mesh load_mesh(const MeshInput& input, MPI_Comm comm, QualityReport* report) {
     if (input.type == "gmsh") {
       whole = read_gmsh(input.file);
     } else if (input.type == "geo") {
-      whole = mesh_geo_file(input.file, h, std::pow(0.5, input.level));
+      // Gmsh caps sizes at MeshSizeMax, then multiplies them by MeshSizeFactor: cap at the
+      // level-0 size and scale by 2^-level, so every size (local ones too) halves per level.
+      whole = mesh_geo_file(input.file, input.size, std::pow(0.5, input.level));
     } else if (input.type == "rectangle") {
       whole = input.structured
                   ? structured_rectangle(input.lower[0], input.lower[1], input.upper[0],
