@@ -24,6 +24,8 @@ so the plots can be redrawn from any set of runs without re-running anything.
 
    writes docs/img/solid_convergence.png and docs/img/fluid_convergence.png (`--img DIR` to
    write elsewhere). If several folders hold the same case and level, the newest one is used.
+   The printed tables also give summary.json -> wall_time_seconds, which leaves out building
+   the mesh (Gmsh meshing of .geo files runs before the clock starts).
 
 Relative error = |value - reference| / |reference|, with the references of the documents
 (Cook linear 23.96 at (48, 52); Cook Neo-Hookean 14.33 mm; Turek-Hron CSM1/CSM2 u(A); DFG 2D-1
@@ -91,7 +93,7 @@ def collect(roots):
 
 
 def series(found, cases):
-    """[(label, [(level, cells, value, error, wall, folder)])] for the cases present."""
+    """[(case, label, [(level, cells, value, error, wall, folder, ranks, beyond)])]."""
     out = []
     for case, quantities in cases.items():
         levels = found.get(case, {})
@@ -109,6 +111,13 @@ def series(found, cases):
                 error = abs(value) if reference is None else abs(value - reference) / abs(reference)
                 rows.append((level, int(benchmark.get("cells", 0)), value, error,
                              summary.get("wall_time_seconds"), path.parent, summary.get("ranks")))
+            # levels whose value lies beyond the reference (the error changed sign since the
+            # coarsest level): marked with "*" in the plot
+            if reference is not None and rows:
+                first = rows[0][2] - reference
+                rows = [row + ((row[2] - reference) * first < 0,) for row in rows]
+            else:
+                rows = [row + (False,) for row in rows]
             out.append((case, label, rows))
     return out
 
@@ -126,11 +135,11 @@ def plot(data, title, image):
         axis.loglog([r[1] for r in rows], [r[3] for r in rows], marker=markers[index % len(markers)],
                     label=label)
         for row in rows:
-            axis.annotate(str(row[0]), (row[1], row[3]), textcoords="offset points", xytext=(3, 3),
+            axis.annotate(str(row[0]) + ("*" if row[7] else ""), (row[1], row[3]), textcoords="offset points", xytext=(3, 3),
                           fontsize=7, alpha=0.7)
     axis.set_xlabel("number of cells")
     axis.set_ylabel("relative error |value − reference| / |reference|")
-    axis.set_title(title + " (labels: mesh level)")
+    axis.set_title(title + " (labels: mesh level; *: beyond the reference)", fontsize=10)
     axis.grid(True, which="both", alpha=0.3)
     axis.legend(fontsize=8)
     figure.tight_layout()
@@ -143,11 +152,12 @@ def plot(data, title, image):
 def print_table(data):
     for case, label, rows in data:
         print(f"\n{label}  ({case})")
-        print("| level | cells | value | error | wall_time_seconds | ranks | folder |")
+        print("| level | cells | value | error | wall_time_seconds (no meshing) | ranks | folder |")
         print("|---|---|---|---|---|---|---|")
-        for level, cells, value, error, wall, folder, ranks in rows:
+        for level, cells, value, error, wall, folder, ranks, beyond in rows:
             wall_text = f"{wall:.3g}" if wall is not None else "?"
-            print(f"| {level} | {cells} | {value:.8g} | {error:.3e} | {wall_text} | {ranks} | {folder} |")
+            print(f"| {level} | {cells} | {value:.8g} | {error:.3e}{' (beyond)' if beyond else ''} "
+                  f"| {wall_text} | {ranks} | {folder} |")
 
 
 def main():
