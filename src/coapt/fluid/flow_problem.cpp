@@ -1,11 +1,13 @@
 #include "coapt/fluid/flow_problem.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <numbers>
 
 #include "coapt/core/context.hpp"
@@ -15,6 +17,7 @@
 #include "coapt/fem/p1.hpp"
 #include "coapt/fluid/kernels.hpp"
 #include "coapt/fluid/navier_stokes.hpp"
+#include "coapt/lumped/windkessel.hpp"
 #include "coapt/mesh/mesh_input.hpp"
 
 namespace coapt::fluid {
@@ -25,7 +28,8 @@ using config::Bounds;
 /// One entry of `boundary:`; later entries override earlier ones at shared vertices.
 struct BoundaryCondition {
   enum class Type { velocity, no_slip, outflow };
-  enum class Profile { constant, parabolic };
+  enum class Profile { constant, parabolic, radial };
+  enum class Waveform { none, sinusoid, table };
   std::string group;
   std::string where;  ///< file:line of the entry
   Type type = Type::no_slip;
@@ -33,10 +37,30 @@ struct BoundaryCondition {
   std::vector<double> value;     ///< velocity (peak for parabolic) [m/s]
   std::vector<double> from, to;  ///< parabolic: the two ends of the profile [m]
   double ramp_time = 0;          ///< > 0: value × (1 − cos(π min(t/T, 1)))/2 [s]
+  std::vector<double> centre;    ///< radial: the axis point of the inlet plane [m]
+  double radius = 0;             ///< radial: value × (1 − r²/radius²) [m]
+  Waveform waveform = Waveform::none;
+  double amplitude = 0;                ///< sinusoid: value × (1 + a sin(2πt/T))
+  double period = 0;                   ///< sinusoid, table: T [s] (table: 0 = not periodic)
+  std::vector<double> times, factors;  ///< table: value × factor(t), linear in between
+};
+
+/// An entry of `outlets:`: the pressure on a facet group, fixed or from a Windkessel.
+struct OutletCondition {
+  enum class Type { do_nothing, traction, windkessel };
+  std::string group;
+  std::string where;
+  Type type = Type::do_nothing;
+  double pressure = 0;  ///< traction: P [Pa]
+  lumped::WindkesselParameters windkessel;
+  double backflow = 0;  ///< β
 };
 
 struct Benchmark {
-  std::string type = "none";  ///< none | cavity | cylinder
+  std::string type = "none";  ///< none | cavity | cylinder | windkessel
+  // windkessel: the outlet whose RCR relation is checked, the period of the inflow
+  std::string outlet;
+  double period = 0;
   // cavity: reference centreline tables (u(0.5, y), v(x, 0.5)), lid speed
   std::vector<double> reference_y, reference_u, reference_x, reference_v;
   int profile_points = 129;
@@ -51,6 +75,7 @@ struct Parameters {
   mesh::MeshInput mesh;
   FluidParameters fluid;
   std::vector<BoundaryCondition> boundary;
+  std::vector<OutletCondition> outlets;
   bool has_pressure_reference = false;
   std::vector<double> pressure_reference;  ///< the vertex nearest to it gets p = 0
   bool steady = true;
@@ -91,12 +116,40 @@ Parameters read(const config::Section& root) {
     if (bc.type == BoundaryCondition::Type::velocity) {
       bc.value = entry.require<std::vector<double>>(
           "value", {"m/s", "velocity vector (the peak for a parabolic profile)"});
-      const auto profile = entry.choice("profile", "constant", {"constant", "parabolic"},
-                                        {"", "constant | parabolic (between `from` and `to`)"});
+      const auto profile = entry.choice(
+          "profile", "constant", {"constant", "parabolic", "radial"},
+          {"", "constant | parabolic (between `from` and `to`) | radial (about `centre`)"});
       if (profile == "parabolic") {
         bc.profile = BoundaryCondition::Profile::parabolic;
         bc.from = entry.require<std::vector<double>>("from", {"m", "one end of the profile"});
         bc.to = entry.require<std::vector<double>>("to", {"m", "the other end"});
+      } else if (profile == "radial") {
+        bc.profile = BoundaryCondition::Profile::radial;
+        bc.centre = entry.require<std::vector<double>>(
+            "centre", {"m", "radial: centre of the inlet (value × (1 − r²/radius²))"});
+        bc.radius = entry.require<double>("radius",
+                                          {"m", "radial: radius of the inlet", Bounds::positive()});
+      }
+      auto waveform = entry.section("waveform", "periodic factor on the value in time");
+      const auto kind = waveform.choice(
+          "type", "none", {"none", "sinusoid", "table"},
+          {"", "none | sinusoid (1 + a sin(2πt/T)) | table (linear in time; steady runs: none)"});
+      if (kind == "sinusoid") {
+        bc.waveform = BoundaryCondition::Waveform::sinusoid;
+        bc.amplitude = waveform.require<double>("amplitude", {"", "a of 1 + a sin(2πt/T)"});
+        bc.period = waveform.require<double>("period", {"s", "period T", Bounds::positive()});
+      } else if (kind == "table") {
+        bc.waveform = BoundaryCondition::Waveform::table;
+        bc.times = waveform.require<std::vector<double>>("times", {"s", "table times, increasing"});
+        bc.factors = waveform.require<std::vector<double>>("values", {"", "factor at each time"});
+        bc.period =
+            waveform.get<double>("period", 0.0,
+                                 {"s", "repeat the table with this period (0: hold the last value)",
+                                  Bounds::non_negative()});
+        if (bc.times.size() < 2 || bc.times.size() != bc.factors.size())
+          waveform.fail("values", "needs at least 2 entries, as many as times");
+        for (std::size_t k = 1; k < bc.times.size(); ++k)
+          if (!(bc.times[k] > bc.times[k - 1])) waveform.fail("times", "must increase");
       }
       bc.ramp_time = entry.get<double>(
           "ramp_time", 0.0,
@@ -105,6 +158,37 @@ Parameters read(const config::Section& root) {
     p.boundary.push_back(std::move(bc));
   }
   if (p.boundary.empty()) root.fail("boundary", "the case needs boundary conditions");
+  for (const auto& entry : root.sections("outlets", "outlet pressures (traction −P n)")) {
+    OutletCondition outlet;
+    outlet.where = entry.where();
+    outlet.group = entry.require<std::string>("group", {"", "boundary group of the outlet"});
+    const auto type = entry.choice(
+        "type", "do_nothing", {"do_nothing", "traction", "windkessel"},
+        {"", "do_nothing (P = 0) | traction (fixed P) | windkessel (RCR, coupled implicitly)"});
+    outlet.type = type == "do_nothing" ? OutletCondition::Type::do_nothing
+                  : type == "traction" ? OutletCondition::Type::traction
+                                       : OutletCondition::Type::windkessel;
+    if (outlet.type == OutletCondition::Type::traction)
+      outlet.pressure = entry.require<double>("pressure", {"Pa", "traction: outlet pressure P"});
+    if (outlet.type == OutletCondition::Type::windkessel) {
+      auto w = entry.section("windkessel",
+                             "RCR parameters: P = R_p Q + P_c, C dP_c/dt = Q − (P_c − P_d)/R_d");
+      auto& wk = outlet.windkessel;
+      wk.proximal_resistance =
+          w.require<double>("proximal_resistance", {"Pa s/m^3", "R_p", Bounds::positive()});
+      wk.compliance = w.require<double>("compliance", {"m^3/Pa", "C", Bounds::positive()});
+      wk.distal_resistance =
+          w.require<double>("distal_resistance", {"Pa s/m^3", "R_d", Bounds::positive()});
+      wk.distal_pressure = w.get<double>("distal_pressure", 0.0, {"Pa", "venous pressure P_d"});
+      wk.initial_pressure = w.get<double>("initial_pressure", 0.0, {"Pa", "P_c at the start"});
+      wk.validate(w.path());
+    }
+    outlet.backflow =
+        entry.get<double>("backflow", 0.2,
+                          {"", "β of the backflow stabilisation −βρ/2 min(u·n, 0) u·w (0: none)",
+                           Bounds::closed(0, 10)});
+    p.outlets.push_back(std::move(outlet));
+  }
   p.has_pressure_reference = root.has("pressure_reference");
   p.pressure_reference = root.get<std::vector<double>>(
       "pressure_reference", {},
@@ -119,8 +203,14 @@ Parameters read(const config::Section& root) {
 
   auto benchmark = root.section("benchmark", "benchmark quantities written to summary.json");
   auto& b = p.benchmark;
-  b.type = benchmark.choice("type", "none", {"none", "cavity", "cylinder"},
-                            {"", "none | cavity (centreline profiles) | cylinder (forces)"});
+  b.type = benchmark.choice(
+      "type", "none", {"none", "cavity", "cylinder", "windkessel"},
+      {"", "none | cavity (centreline profiles) | cylinder (forces) | windkessel (RCR check)"});
+  if (b.type == "windkessel") {
+    b.outlet = benchmark.require<std::string>("outlet", {"", "group of a windkessel outlet"});
+    b.period = benchmark.require<double>(
+        "period", {"s", "the statistics cover the last period", Bounds::positive()});
+  }
   if (b.type == "cavity") {
     b.reference_y = benchmark.get<std::vector<double>>("reference_y", {}, {"m", "table y"});
     b.reference_u = benchmark.get<std::vector<double>>("reference_u", {}, {"m/s", "u(0.5, y)"});
@@ -236,6 +326,22 @@ class FlowProblem final : public run::Problem {
       if (bc.profile == BoundaryCondition::Profile::parabolic &&
           (static_cast<int>(bc.from.size()) != dim || static_cast<int>(bc.to.size()) != dim))
         throw InputError(fmt::format("{}: from/to: need {} coordinates each", bc.where, dim));
+      if (bc.profile == BoundaryCondition::Profile::radial &&
+          static_cast<int>(bc.centre.size()) != dim)
+        throw InputError(fmt::format("{}: centre: needs {} coordinates", bc.where, dim));
+    }
+    for (const auto& outlet : parameters_.outlets) {
+      const auto* group = mesh_.find_group(outlet.group);
+      if (!group || group->dim != dim - 1)
+        throw InputError(fmt::format("{}: group: no boundary group '{}' in {} ({})", outlet.where,
+                                     outlet.group, mesh_.source, boundary_group_names()));
+      for (std::size_t k = 0; k < parameters_.boundary.size(); ++k)
+        if (tags_[k] == group->tag &&
+            parameters_.boundary[k].type != BoundaryCondition::Type::outflow)
+          throw InputError(fmt::format("{}: group: '{}' is also a velocity/no-slip boundary ({})",
+                                       outlet.where, outlet.group, parameters_.boundary[k].where));
+      outlet_tags_.push_back(group->tag);
+      outflow = true;
     }
     if (!outflow && !parameters_.has_pressure_reference)
       throw InputError(fmt::format(
@@ -251,6 +357,17 @@ class FlowProblem final : public run::Problem {
         throw InputError(fmt::format("benchmark.body: no boundary group '{}' in {} ({})", b.body,
                                      mesh_.source, boundary_group_names()));
       body_tag_ = body->tag;
+    }
+    if (b.type == "windkessel") {
+      for (std::size_t k = 0; k < parameters_.outlets.size(); ++k)
+        if (parameters_.outlets[k].group == b.outlet &&
+            parameters_.outlets[k].type == OutletCondition::Type::windkessel)
+          benchmark_outlet_ = static_cast<int>(k);
+      if (benchmark_outlet_ < 0)
+        throw InputError(fmt::format(
+            "benchmark.outlet: '{}' is not a windkessel outlet of `outlets`", b.outlet));
+      if (parameters_.steady)
+        throw InputError("benchmark.type: windkessel needs a transient run (time.steady: false)");
     }
     if ((b.type == "cavity" || !b.pressure_points.empty()) && dim != 2)
       throw InputError("benchmark: the cavity profiles and pressure probes are 2D quantities");
@@ -274,11 +391,13 @@ class FlowProblem final : public run::Problem {
     NavierStokes fluid(mesh_, parameters_.fluid);
     log::info("linear solver: {}", fluid.describe_solver());
     setup_dirichlet(fluid);
+    setup_outlets(fluid);
     const auto& p = parameters_;
     int newton_total = 0, linear_total = 0;
     TimeLevel level;
     if (p.steady) {
       write_boundary_values(fluid, std::numeric_limits<double>::infinity());
+      set_outlet_pressures(fluid, 0.0);
       ScopedTimer timer(output.timers(), "solve");
       const auto report = fluid.solve(level, "steady solve");
       newton_total = report.iterations;
@@ -286,6 +405,7 @@ class FlowProblem final : public run::Problem {
       log::info("steady: {} Newton iterations, {} linear iterations, residual {:.3e} -> {:.3e}",
                 report.iterations, report.linear_iterations, report.residual_history.front(),
                 report.residual_history.back());
+      log::info("steady: Newton residuals {:.3e}", fmt::join(report.residual_history, ", "));
       record_step(fluid, level, output, 0.0, report);
     } else {
       auto previous = fem::create_vertex_vector(mesh_, mesh_.dim + 1);
@@ -306,11 +426,17 @@ class FlowProblem final : public run::Problem {
         level.before_previous = before;
         time += dt;
         write_boundary_values(fluid, time);
+        set_outlet_pressures(fluid, dt);
         NewtonReport report;
         {
           ScopedTimer timer(output.timers(), "solve");
           report = fluid.solve(level, fmt::format("step {} (t = {:g} s)", step, time));
         }
+        if (step <= 2 || step == n_steps)
+          log::info("step {}: Newton residuals {:.3e}", step,
+                    fmt::join(report.residual_history, ", "));
+        for (std::size_t k = 0; k < windkessels_.size(); ++k)
+          if (windkessels_[k]) windkessels_[k]->advance(fluid.outlet_flow(k), dt);
         newton_total += report.iterations;
         linear_total += report.linear_iterations;
         last_step = dt;
@@ -320,6 +446,10 @@ class FlowProblem final : public run::Problem {
             fmt::format("newton {}, ksp {}", report.iterations, report.linear_iterations));
       }
     }
+    for (std::size_t k = 0; k < windkessels_.size(); ++k)
+      if (windkessels_[k])  // for a later restart: lumped::Windkessel::restore takes it back
+        output.summary()["windkessel_state"][p.outlets[k].group] =
+            io::Json::array_of(windkessels_[k]->state());
     auto& iterations = output.summary()["iterations"];
     iterations["newton"] = newton_total;
     iterations["linear"] = linear_total;
@@ -376,6 +506,68 @@ class FlowProblem final : public run::Problem {
     fluid.set_dirichlet_dofs(std::move(dofs));
   }
 
+  /// Gives the fluid its outlets; builds a Windkessel per windkessel outlet. Collective.
+  void setup_outlets(NavierStokes& fluid) {
+    std::vector<Outlet> outlets;
+    windkessels_.clear();
+    for (std::size_t k = 0; k < parameters_.outlets.size(); ++k) {
+      const auto& outlet = parameters_.outlets[k];
+      outlets.push_back({outlet_tags_[k], outlet.backflow, 0.0, 0.0});
+      windkessels_.push_back(outlet.type == OutletCondition::Type::windkessel
+                                 ? std::make_unique<lumped::Windkessel>(outlet.windkessel)
+                                 : nullptr);
+      log::info(
+          "outlet '{}': {}, backflow beta = {:g}", outlet.group,
+          outlet.type == OutletCondition::Type::windkessel
+              ? fmt::format("RCR R_p = {:g}, C = {:g}, R_d = {:g}, P_d = {:g}",
+                            outlet.windkessel.proximal_resistance, outlet.windkessel.compliance,
+                            outlet.windkessel.distal_resistance, outlet.windkessel.distal_pressure)
+          : outlet.type == OutletCondition::Type::traction
+              ? fmt::format("pressure {:g} Pa", outlet.pressure)
+              : std::string("do-nothing"),
+          outlet.backflow);
+    }
+    fluid.set_outlets(outlets);
+  }
+
+  /// P = R Q + offset of every outlet for a step of size dt (≤ 0: steady, where a Windkessel
+  /// is its total resistance: P = (R_p + R_d) Q + P_d).
+  void set_outlet_pressures(NavierStokes& fluid, double dt) {
+    for (std::size_t k = 0; k < parameters_.outlets.size(); ++k) {
+      const auto& outlet = parameters_.outlets[k];
+      if (outlet.type == OutletCondition::Type::windkessel) {
+        const auto& wk = outlet.windkessel;
+        if (dt > 0) {
+          const auto relation = windkessels_[k]->relation(dt);
+          fluid.set_outlet_pressure(k, relation.effective_resistance, relation.offset);
+        } else {
+          fluid.set_outlet_pressure(k, wk.proximal_resistance + wk.distal_resistance,
+                                    wk.distal_pressure);
+        }
+      } else {
+        fluid.set_outlet_pressure(k, 0.0, outlet.pressure);
+      }
+    }
+  }
+
+  /// Series columns of the flows: flow_<group> (out of the domain) of each velocity group,
+  /// outlet_flow_<group> and outlet_pressure_<group> of each outlet; keeps the benchmark's.
+  void record_flows(NavierStokes& fluid, double time, io::CsvSeries& series) {
+    for (std::size_t k = 0; k < parameters_.boundary.size(); ++k)
+      if (parameters_.boundary[k].type == BoundaryCondition::Type::velocity)
+        series.add("flow_" + parameters_.boundary[k].group, fluid.boundary_flow(tags_[k]));
+    for (std::size_t k = 0; k < parameters_.outlets.size(); ++k) {
+      const double flow = fluid.outlet_flow(k), pressure = fluid.outlet_pressure(k);
+      series.add("outlet_flow_" + parameters_.outlets[k].group, flow);
+      series.add("outlet_pressure_" + parameters_.outlets[k].group, pressure);
+      if (static_cast<int>(k) == benchmark_outlet_) {
+        history_time_.push_back(time);
+        history_flow_.push_back(flow);
+        history_pressure_.push_back(pressure);
+      }
+    }
+  }
+
   /// Writes the boundary velocities at time `time` into the state (t = ∞: ramps finished).
   void write_boundary_values(NavierStokes& fluid, double time) {
     const int dim = mesh_.dim, n = dim + 1;
@@ -397,7 +589,12 @@ class FlowProblem final : public run::Problem {
           }
           const double s = std::clamp(along / length2, 0.0, 1.0);
           factor *= 4 * s * (1 - s);
+        } else if (bc.profile == BoundaryCondition::Profile::radial) {
+          double r2 = 0;
+          for (int i = 0; i < dim; ++i) r2 += std::pow(mesh_.point(v)[i] - bc.centre[i], 2);
+          factor *= std::max(0.0, 1 - r2 / (bc.radius * bc.radius));
         }
+        factor *= waveform_factor(bc, time);
       }
       for (int i = 0; i < dim; ++i) {
         const double value =
@@ -409,6 +606,21 @@ class FlowProblem final : public run::Problem {
     COAPT_PETSC_CHECK(VecAssemblyBegin(fluid.state()));
     COAPT_PETSC_CHECK(VecAssemblyEnd(fluid.state()));
     fem::update_ghosts(fluid.state());
+  }
+
+  /// The waveform's factor at time t (1 when steady, t = ∞).
+  static double waveform_factor(const BoundaryCondition& bc, double time) {
+    if (!std::isfinite(time) || bc.waveform == BoundaryCondition::Waveform::none) return 1.0;
+    if (bc.waveform == BoundaryCondition::Waveform::sinusoid)
+      return 1 + bc.amplitude * std::sin(2 * std::numbers::pi * time / bc.period);
+    double t = time;
+    if (bc.period > 0) t = bc.times.front() + std::fmod(time - bc.times.front(), bc.period);
+    if (t <= bc.times.front()) return bc.factors.front();
+    if (t >= bc.times.back()) return bc.factors.back();
+    const auto k = static_cast<std::size_t>(std::upper_bound(bc.times.begin(), bc.times.end(), t) -
+                                            bc.times.begin());
+    const double s = (t - bc.times[k - 1]) / (bc.times[k] - bc.times[k - 1]);
+    return (1 - s) * bc.factors[k - 1] + s * bc.factors[k];
   }
 
   void record_step(NavierStokes& fluid, const TimeLevel& level, run::RunOutput& output, double time,
@@ -426,6 +638,7 @@ class FlowProblem final : public run::Problem {
       series.add("drag_coefficient", scale * force[0]);
       series.add("lift_coefficient", scale * force[1]);
     }
+    record_flows(fluid, time, series);
     series.end_row();
   }
 
@@ -458,7 +671,70 @@ class FlowProblem final : public run::Problem {
       }
     } else if (b.type == "cavity") {
       cavity_profiles(fluid, output, json);
+    } else if (b.type == "windkessel") {
+      windkessel_benchmark(json);
     }
+  }
+
+  /// Checks the outlet's (Q, P) history against the RCR model integrated independently:
+  /// C dP_c/dt = Q(t) − (P_c − P_d)/R_d with Q linear between the steps (constant Q₁ on the
+  /// first step: the initial state is not a solution), 64 RK4 substeps per step, and
+  /// P_RCR = R_p Q + P_c. Reports max over the last period of |P − P_RCR| / max|P|, and the
+  /// mean (trapezoidal) and amplitude ((max − min)/2) of P over the last period.
+  void windkessel_benchmark(io::Json& json) {
+    const auto& b = parameters_.benchmark;
+    const auto& wk = parameters_.outlets[static_cast<std::size_t>(benchmark_outlet_)].windkessel;
+    const auto& t = history_time_;
+    const auto& q = history_flow_;
+    const auto& p = history_pressure_;
+    if (t.size() < 2) return;
+    const auto rate = [&](double flow, double pc) {
+      return (flow - (pc - wk.distal_pressure) / wk.distal_resistance) / wk.compliance;
+    };
+    std::vector<double> model(t.size());
+    double pc = wk.initial_pressure, previous_time = 0;
+    constexpr int substeps = 64;
+    for (std::size_t k = 0; k < t.size(); ++k) {
+      const double dt = t[k] - previous_time;
+      const double q0 = k == 0 ? q[0] : q[k - 1], q1 = q[k];
+      const double h = dt / substeps;
+      for (int j = 0; j < substeps; ++j) {
+        const auto flow = [&](double s) { return q0 + (q1 - q0) * s; };
+        const double s0 = static_cast<double>(j) / substeps, s1 = (j + 1.0) / substeps;
+        const double sm = 0.5 * (s0 + s1);
+        const double k1 = rate(flow(s0), pc), k2 = rate(flow(sm), pc + 0.5 * h * k1),
+                     k3 = rate(flow(sm), pc + 0.5 * h * k2), k4 = rate(flow(s1), pc + h * k3);
+        pc += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+      }
+      model[k] = wk.proximal_resistance * q1 + pc;
+      previous_time = t[k];
+    }
+    const double start = t.back() - b.period * (1 + 1e-9);
+    double max_pressure = 0, max_difference = 0, low = std::numeric_limits<double>::max(),
+           high = -low, integral = 0, flow_integral = 0;
+    for (std::size_t k = 0; k < t.size(); ++k) {
+      if (t[k] < start) continue;
+      max_pressure = std::max(max_pressure, std::abs(p[k]));
+      max_difference = std::max(max_difference, std::abs(p[k] - model[k]));
+      low = std::min(low, p[k]);
+      high = std::max(high, p[k]);
+      if (k > 0 && t[k - 1] >= start) {
+        integral += 0.5 * (p[k] + p[k - 1]) * (t[k] - t[k - 1]);
+        flow_integral += 0.5 * (q[k] + q[k - 1]) * (t[k] - t[k - 1]);
+      }
+    }
+    const double covered =
+        t.back() - *std::find_if(t.begin(), t.end(), [&](double x) { return x >= start; });
+    json["rcr_relative_error"] = max_difference / max_pressure;
+    json["outlet_pressure_mean"] = covered > 0 ? integral / covered : p.back();
+    json["outlet_pressure_amplitude"] = 0.5 * (high - low);
+    json["outlet_flow_mean"] = covered > 0 ? flow_integral / covered : q.back();
+    json["last_period_start"] = t.back() - covered;
+    log::info(
+        "windkessel '{}': max |P - P_RCR| / max |P| = {:.3e} over the last period; P mean "
+        "{:.6g} Pa, amplitude {:.6g} Pa",
+        b.outlet, max_difference / max_pressure, integral / std::max(covered, 1e-300),
+        0.5 * (high - low));
   }
 
   void cavity_profiles(NavierStokes& fluid, run::RunOutput& output, io::Json& json) {
@@ -538,6 +814,10 @@ class FlowProblem final : public run::Problem {
   std::vector<int> tags_;                 ///< facet tag of each boundary entry
   std::vector<int> condition_of_vertex_;  ///< per owned vertex: the boundary entry, or −1
   int body_tag_ = -1;
+  std::vector<int> outlet_tags_;  ///< facet tag of each outlet entry
+  std::vector<std::unique_ptr<lumped::Windkessel>> windkessels_;  ///< per outlet, or null
+  int benchmark_outlet_ = -1;  ///< the outlet of the windkessel benchmark
+  std::vector<double> history_time_, history_flow_, history_pressure_;  ///< of that outlet
 };
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <petscksp.h>
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <optional>
@@ -32,6 +33,35 @@ std::string format_history(const std::vector<double>& history) {
   for (std::size_t k = 0; k < history.size(); ++k)
     text += fmt::format("{}{:.3e}", k ? ", " : "", history[k]);
   return text;
+}
+
+/// Unit normal out of the domain (away from the facet's cell) and measure of boundary facet f.
+void facet_geometry(const mesh::Mesh& mesh, int f, double* normal, double& measure) {
+  const int dim = mesh.dim;
+  const int* v = mesh.facets.data() + static_cast<std::size_t>(f) * dim;
+  const auto p0 = mesh.point(v[0]), p1 = mesh.point(v[1]);
+  double direction[3] = {};
+  if (dim == 2) {
+    direction[0] = p1[1] - p0[1];
+    direction[1] = -(p1[0] - p0[0]);
+  } else {
+    const auto p2 = mesh.point(v[2]);
+    const double e1[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+    const double e2[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+    direction[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    direction[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    direction[2] = e1[0] * e2[1] - e1[1] * e2[0];
+  }
+  const double length = std::sqrt(direction[0] * direction[0] + direction[1] * direction[1] +
+                                  direction[2] * direction[2]);
+  measure = dim == 2 ? length : 0.5 * length;
+  // The cell's vertex off the facet lies on the inner side.
+  double inward = 0;
+  for (const int w : mesh.cell(mesh.facet_cell[f]))
+    if (std::find(v, v + dim, w) == v + dim)
+      for (int i = 0; i < dim; ++i) inward += direction[i] * (mesh.point(w)[i] - p0[i]);
+  const double sign = inward > 0 ? -1.0 : 1.0;
+  for (int i = 0; i < dim; ++i) normal[i] = sign * direction[i] / length;
 }
 
 }  // namespace
@@ -83,6 +113,156 @@ void NavierStokes::set_velocity_constraint(std::span<const int> vertices,
   COAPT_PETSC_CHECK(VecAssemblyBegin(state_));
   COAPT_PETSC_CHECK(VecAssemblyEnd(state_));
   fem::update_ghosts(state_);
+}
+
+void NavierStokes::set_outlets(const std::vector<Outlet>& outlets) {
+  const int dim = mesh_.dim;
+  outlets_ = outlets;
+  outlet_flux_.clear();
+  for (const auto& outlet : outlets_) outlet_flux_.push_back(flux_vector(outlet.tag));
+  // Backflow facets of every local cell (ghost cells too: the matrix rows of owned vertices
+  // need them), packed as local[dim], normal[dim], measure, βρ/2 and grouped by cell.
+  const std::size_t stride = 2 * static_cast<std::size_t>(dim) + 2;
+  std::vector<std::pair<int, std::vector<double>>> facets;
+  for (int f = 0; f < mesh_.n_facets(); ++f)
+    for (const auto& outlet : outlets_) {
+      if (outlet.tag != mesh_.facet_tags[f] || outlet.backflow <= 0) continue;
+      std::vector<double> data(stride);
+      const int c = mesh_.facet_cell[f];
+      const auto cell = mesh_.cell(c);
+      for (int a = 0; a < dim; ++a) {
+        const int v = mesh_.facets[static_cast<std::size_t>(f) * dim + a];
+        data[a] = static_cast<double>(std::find(cell.begin(), cell.end(), v) - cell.begin());
+      }
+      facet_geometry(mesh_, f, data.data() + dim, data[2 * dim]);
+      data[2 * dim + 1] = 0.5 * outlet.backflow * parameters_.density;
+      facets.emplace_back(c, std::move(data));
+      break;
+    }
+  std::stable_sort(facets.begin(), facets.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  backflow_offsets_.assign(static_cast<std::size_t>(mesh_.n_cells()) + 1, 0);
+  backflow_data_.clear();
+  for (const auto& [c, data] : facets) {
+    ++backflow_offsets_[c + 1];
+    backflow_data_.insert(backflow_data_.end(), data.begin(), data.end());
+  }
+  for (int c = 0; c < mesh_.n_cells(); ++c) backflow_offsets_[c + 1] += backflow_offsets_[c];
+}
+
+void NavierStokes::set_outlet_pressure(std::size_t k, double resistance, double offset) {
+  if (k >= outlets_.size()) throw InternalError("set_outlet_pressure: no such outlet");
+  if (!(resistance >= 0) || !std::isfinite(resistance) || !std::isfinite(offset))
+    throw InternalError("set_outlet_pressure: the resistance must be finite and >= 0");
+  outlets_[k].resistance = resistance;
+  outlets_[k].offset = offset;
+}
+
+double NavierStokes::outlet_flow(std::size_t k) const {
+  PetscScalar flow = 0;
+  COAPT_PETSC_CHECK(VecDot(outlet_flux_.at(k), state_, &flow));
+  return flow;
+}
+
+double NavierStokes::outlet_pressure(std::size_t k) const {
+  return outlets_.at(k).resistance * outlet_flow(k) + outlets_[k].offset;
+}
+
+double NavierStokes::boundary_flow(int tag) const {
+  const auto flux = flux_vector(tag);
+  PetscScalar flow = 0;
+  COAPT_PETSC_CHECK(VecDot(flux, state_, &flow));
+  return flow;
+}
+
+OwnedVec NavierStokes::flux_vector(int tag) const {
+  const int dim = mesh_.dim, n = dim + 1;
+  auto flux = fem::create_vertex_vector(mesh_, n);
+  Vec local = nullptr;
+  COAPT_PETSC_CHECK(VecGhostGetLocalForm(flux, &local));
+  COAPT_PETSC_CHECK(VecSet(local, 0.0));
+  PetscScalar* data = nullptr;
+  COAPT_PETSC_CHECK(VecGetArray(local, &data));
+  // ∫_F φ_v n = |F|/dim n for each vertex of a flat facet; owned cells count each facet once.
+  for (int f = 0; f < mesh_.n_facets(); ++f) {
+    if (mesh_.facet_tags[f] != tag || mesh_.facet_cell[f] >= mesh_.n_owned_cells) continue;
+    double normal[3], measure = 0;
+    facet_geometry(mesh_, f, normal, measure);
+    for (int a = 0; a < dim; ++a) {
+      const int v = mesh_.facets[static_cast<std::size_t>(f) * dim + a];
+      for (int i = 0; i < dim; ++i)
+        data[static_cast<std::size_t>(v) * n + i] += measure / dim * normal[i];
+    }
+  }
+  COAPT_PETSC_CHECK(VecRestoreArray(local, &data));
+  COAPT_PETSC_CHECK(VecGhostRestoreLocalForm(flux, &local));
+  fem::add_local_to_global(flux);
+  return flux;
+}
+
+void NavierStokes::add_outlet_tractions() {
+  // The traction −P n tested with w gives ∫_Γ P n·w = P bᵀw.
+  for (std::size_t k = 0; k < outlets_.size(); ++k) {
+    const double pressure = outlet_pressure(k);
+    if (pressure != 0.0) COAPT_PETSC_CHECK(VecAXPY(residual_, pressure, outlet_flux_[k]));
+  }
+}
+
+void NavierStokes::residual(const TimeLevel& time, Vec result) {
+  assemble_residual(time);
+  COAPT_PETSC_CHECK(VecCopy(residual_, result));
+}
+
+void NavierStokes::jacobian_action(const TimeLevel& time, Vec direction, Vec result) {
+  assemble_system(time);
+  COAPT_PETSC_CHECK(MatMult(matrix_.mat(), direction, result));
+  for (std::size_t k = 0; k < outlets_.size(); ++k) {
+    PetscScalar projection = 0;
+    COAPT_PETSC_CHECK(VecDot(outlet_flux_[k], direction, &projection));
+    COAPT_PETSC_CHECK(VecAXPY(result, outlets_[k].resistance * projection, outlet_flux_[k]));
+  }
+}
+
+int NavierStokes::solve_with_outlets(Vec rhs, Vec solution, const std::vector<PetscInt>& fixed) {
+  int iterations = solver_.solve(rhs, solution).iterations;
+  std::vector<std::size_t> coupled;
+  for (std::size_t k = 0; k < outlets_.size(); ++k)
+    if (outlets_[k].resistance != 0.0) coupled.push_back(k);
+  if (coupled.empty()) return iterations;
+  // Woodbury: (J + B D Bᵀ)⁻¹r = y − Z (I + D BᵀZ)⁻¹ D Bᵀy with y = J⁻¹r, Z = J⁻¹B, one extra
+  // solve per coupled outlet with the factorisation J already has. B's columns are the flux
+  // vectors with the fixed dofs zeroed (their rows of J are identity rows).
+  const std::size_t m = coupled.size();
+  std::vector<OwnedVec> columns(m), images(m);
+  const std::vector<PetscScalar> zeros(fixed.size(), 0.0);
+  for (std::size_t j = 0; j < m; ++j) {
+    COAPT_PETSC_CHECK(VecDuplicate(outlet_flux_[coupled[j]], columns[j].out()));
+    COAPT_PETSC_CHECK(VecCopy(outlet_flux_[coupled[j]], columns[j]));
+    COAPT_PETSC_CHECK(VecSetValues(columns[j], static_cast<PetscInt>(fixed.size()), fixed.data(),
+                                   zeros.data(), INSERT_VALUES));
+    COAPT_PETSC_CHECK(VecAssemblyBegin(columns[j]));
+    COAPT_PETSC_CHECK(VecAssemblyEnd(columns[j]));
+    COAPT_PETSC_CHECK(VecDuplicate(columns[j], images[j].out()));
+    COAPT_PETSC_CHECK(VecSet(images[j], 0.0));
+    iterations += solver_.solve(columns[j], images[j]).iterations;
+  }
+  Eigen::MatrixXd capacitance(m, m);
+  Eigen::VectorXd projected(m);
+  for (std::size_t j = 0; j < m; ++j) {
+    const double resistance = outlets_[coupled[j]].resistance;
+    PetscScalar value = 0;
+    COAPT_PETSC_CHECK(VecDot(columns[j], solution, &value));
+    projected(static_cast<Eigen::Index>(j)) = resistance * value;
+    for (std::size_t l = 0; l < m; ++l) {
+      COAPT_PETSC_CHECK(VecDot(columns[j], images[l], &value));
+      capacitance(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(l)) =
+          (j == l ? 1.0 : 0.0) + resistance * value;
+    }
+  }
+  const Eigen::VectorXd coefficients = capacitance.partialPivLu().solve(projected);
+  for (std::size_t l = 0; l < m; ++l)
+    COAPT_PETSC_CHECK(VecAXPY(solution, -coefficients(static_cast<Eigen::Index>(l)), images[l]));
+  return iterations;
 }
 
 std::vector<PetscInt> NavierStokes::all_fixed_dofs() const {
@@ -138,18 +318,41 @@ void NavierStokes::assemble(const TimeLevel& time, bool with_matrix) {
     }
     set_stabilisation<Dim>(data, mean, time.time_step, parameters_.c_inverse);
   };
+  // The backflow facets of local cell c, unpacked from set_outlets' layout.
+  auto backflow_facets = [&](int c, auto&& use) {
+    if (backflow_offsets_.empty()) return;
+    constexpr std::size_t stride = 2 * Dim + 2;
+    for (int k = backflow_offsets_[c]; k < backflow_offsets_[c + 1]; ++k) {
+      const double* packed = backflow_data_.data() + static_cast<std::size_t>(k) * stride;
+      OutletFacet<Dim> facet;
+      for (int a = 0; a < Dim; ++a) {
+        facet.local[a] = static_cast<int>(packed[a]);
+        facet.normal[a] = packed[Dim + a];
+      }
+      facet.measure = packed[2 * Dim];
+      facet.backflow_coefficient = packed[2 * Dim + 1];
+      use(facet);
+    }
+  };
   fem::assemble_vector(mesh_, n, residual_, [&](int c, double* r) {
     ElementData<Dim> data;
     double x[m];
     element(c, data, x);
     element_residual<Dim, double>(data, x, r);
+    backflow_facets(c, [&](const OutletFacet<Dim>& facet) {
+      backflow_facet_residual<Dim, double>(facet, x, r);
+    });
   });
+  add_outlet_tractions();
   if (with_matrix)
     matrix_.assemble([&](int c, double* K) {
       ElementData<Dim> data;
       double x[m];
       element(c, data, x);
       element_residual_and_jacobian<Dim>(data, x, nullptr, K);
+      backflow_facets(c, [&](const OutletFacet<Dim>& facet) {
+        backflow_facet_residual_and_jacobian<Dim>(facet, x, nullptr, K);
+      });
     });
 }
 
@@ -218,8 +421,7 @@ NewtonReport NavierStokes::solve(const TimeLevel& time, const std::string& label
     COAPT_PETSC_CHECK(VecSet(correction_, 0.0));
     solver_.set_operator(matrix_.mat());
     try {
-      const auto stats = solver_.solve(free_residual_, correction_);
-      report.linear_iterations += stats.iterations;
+      report.linear_iterations += solve_with_outlets(free_residual_, correction_, fixed);
     } catch (const ConvergenceError& error) {
       throw ConvergenceError(fmt::format("fluid Newton, {}, iteration {}: {}; residual history {}",
                                          label, iteration + 1, error.what(),

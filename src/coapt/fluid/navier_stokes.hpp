@@ -13,6 +13,7 @@
 #include <petscvec.h>
 
 #include <array>
+#include <cstddef>
 #include <span>
 #include <string>
 #include <vector>
@@ -51,6 +52,17 @@ struct NewtonReport {
   std::vector<double> residual_history;  ///< ‖R‖ of the free dofs, one per iterate
 };
 
+/// An outlet: a facet group on which the traction is −P n with P = resistance·Q + offset,
+/// Q = ∫_Γ u·n the flow out through the group (the do-nothing condition is P = 0, a fixed
+/// pressure has resistance 0, an implicitly coupled Windkessel gives its R_eff and offset per
+/// step), plus backflow stabilisation with coefficient β (kernels.hpp).
+struct Outlet {
+  int tag = -1;           ///< facet tag of the group
+  double backflow = 0;    ///< β (0: no backflow stabilisation)
+  double resistance = 0;  ///< dP/dQ [Pa s/m³] (2D: per unit depth), ≥ 0
+  double offset = 0;      ///< P at Q = 0 [Pa]
+};
+
 /// The discrete Navier–Stokes operator on one mesh. Every call is collective on mesh.comm.
 class NavierStokes {
  public:
@@ -68,6 +80,24 @@ class NavierStokes {
   /// (vertices.size() × dim, row-major) [m/s]; replaces the previous constraint. The state is
   /// updated at those dofs; the matrix pattern stays fixed.
   void set_velocity_constraint(std::span<const int> vertices, std::span<const double> velocities);
+
+  /// Replaces the outlets (their facet groups must carry no Dirichlet velocity). Collective.
+  void set_outlets(const std::vector<Outlet>& outlets);
+  /// Sets P = resistance·Q + offset on outlet k (index into set_outlets' list) for the next
+  /// solves. Not collective; every rank must give the same values.
+  void set_outlet_pressure(std::size_t k, double resistance, double offset);
+  /// Q = ∫_Γ u·n [m³/s in 3D, m²/s in 2D] through outlet k at the current state. Collective.
+  double outlet_flow(std::size_t k) const;
+  /// The outlet's pressure P = resistance·Q + offset at the current state [Pa]. Collective.
+  double outlet_pressure(std::size_t k) const;
+  /// ∫_Γ u·n over the facets tagged `tag` at the current state (n outward). Collective.
+  double boundary_flow(int tag) const;
+
+  /// The full residual R(state) (Dirichlet rows included) into `result`. Collective.
+  void residual(const TimeLevel& time, Vec result);
+  /// The Newton Jacobian applied to `direction`: J d + Σ_k R_k b_k (b_kᵀ d), the sparse part
+  /// assembled at the current state (no Dirichlet rows removed). Collective.
+  void jacobian_action(const TimeLevel& time, Vec direction, Vec result);
 
   /// Newton's method to the tolerances of FluidParameters; throws ConvergenceError with the
   /// residual history when it fails or meets a non-finite residual. `label` names the step.
@@ -94,6 +124,21 @@ class NavierStokes {
   /// ‖R‖ over the free dofs (a copy with Dirichlet rows zeroed goes into free_residual_).
   double free_residual_norm();
   std::vector<PetscInt> all_fixed_dofs() const;
+  /// b with b_(v,i) = ∫_Γ φ_v n_i over the owned-cell facets tagged `tag` (pressure entries 0),
+  /// so that Q = bᵀx for P1 velocities.
+  OwnedVec flux_vector(int tag) const;
+  /// Adds Σ_k P_k(Q_k) b_k to residual_.
+  void add_outlet_tractions();
+  /// Solves (J + Σ_k R_k b̃_k b̃_kᵀ) x = rhs (b̃: b with fixed dofs zeroed) with the factorised
+  /// J and the Woodbury formula; returns the Krylov iterations of all solves.
+  int solve_with_outlets(Vec rhs, Vec solution, const std::vector<PetscInt>& fixed);
+
+  /// Per outlet: its settings and flux vector b.
+  std::vector<Outlet> outlets_;
+  std::vector<OwnedVec> outlet_flux_;
+  /// Backflow facets grouped by local cell (CSR: offsets per cell into the facet data).
+  std::vector<int> backflow_offsets_;
+  std::vector<double> backflow_data_;  ///< per facet: local[dim], normal[dim], measure, βρ/2
 
   const mesh::Mesh& mesh_;
   const FluidParameters parameters_;
