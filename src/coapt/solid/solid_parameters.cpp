@@ -3,6 +3,8 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+
 #include "coapt/core/error.hpp"
 
 namespace coapt::solid {
@@ -183,6 +185,28 @@ SolidParameters SolidParameters::read(const config::Section& root) {
   p.newton.max_iterations = newton.get<int>(
       "max_iterations", 25, {"", "iterations per load step", Bounds::closed(1, 1000)});
 
+  auto time = root.section("time", "time integration (static load stepping or Newmark)");
+  p.time.where = located(time);
+  p.time.dynamic =
+      time.choice("scheme", "static", {"static", "newmark"},
+                  {"", "static: load steps; newmark: dynamics, beta 1/4, gamma 1/2"}) == "newmark";
+  if (p.time.dynamic) {
+    p.time.step = time.require<double>("step", {"s", "time step", Bounds::positive()});
+    p.time.end_time = time.require<double>("end_time", {"s", "final time", Bounds::positive()});
+    const double ratio = p.time.end_time / p.time.step;
+    p.time.n_steps = static_cast<int>(std::lround(ratio));
+    if (p.time.n_steps < 1 || std::abs(ratio - p.time.n_steps) > 1e-6 * ratio)
+      time.fail("end_time",
+                fmt::format("end_time = {:g} s is not a whole number of steps of {:g} s",
+                            p.time.end_time, p.time.step));
+    p.time.initial_velocity = time.get<std::vector<double>>(
+        "initial_velocity", {}, {"m/s", "uniform initial velocity of the free dofs (empty: rest)"});
+    if (root.has("steps"))
+      root.fail("steps",
+                "load steps are for the static scheme; with time.scheme = newmark the "
+                "loads act in full from t = 0 (remove steps)");
+  }
+
   for (const auto& section : root.sections("probes", "points where the displacement is reported")) {
     ProbeParameters probe;
     probe.where = located(section);
@@ -193,6 +217,9 @@ SolidParameters SolidParameters::read(const config::Section& root) {
 
   auto output = root.section("output", "what the run writes");
   p.write_vtk = output.get<bool>("vtk", true, {"", "write displacement and stresses as VTK"});
+  p.vtk_interval = output.get<int>(
+      "vtk_interval", 1,
+      {"", "time steps between VTK files (newmark scheme)", Bounds::closed(1, 1000000)});
   return p;
 }
 
@@ -211,6 +238,8 @@ void SolidParameters::check_dimension(int dim) const {
   }
   for (const auto& load : tractions) check(load.vector.size(), load.where, "the load vector");
   if (!gravity.empty()) check(gravity.size(), gravity_where, "gravity");
+  if (!time.initial_velocity.empty())
+    check(time.initial_velocity.size(), time.where + ".initial_velocity", "initial_velocity");
   for (const auto& probe : probes) check(probe.point.size(), probe.where, "point");
   if (dim == 2)
     for (const auto& body : bodies)

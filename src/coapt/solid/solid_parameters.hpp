@@ -16,10 +16,12 @@
 ///     - {boundary: right, traction: [0, 62500]}       Pa (force per reference area/length)
 ///     - {boundary: right, total_force: [0, 1]}        N (3D) or N/m (2D): spread uniformly
 ///   gravity: [0, -2]                   m/s², body force ρ g, ramped
-///   steps: 10                          load steps (load factor k/steps)
+///   steps: 10                          load steps (load factor k/steps; static only)
+///   time: {scheme: newmark, step: 0.005, end_time: 10, initial_velocity: [0, 0.1]}
+///                                      dynamics (dynamics.hpp); scheme: static (default)
 ///   newton: {relative_tolerance, absolute_tolerance, update_tolerance, max_iterations}
 ///   probes: [{name: tip, point: [0.048, 0.060]}]
-///   output: {vtk: true}
+///   output: {vtk: true, vtk_interval: 10}   (vtk_interval: time steps between VTK files)
 
 #include <string>
 #include <vector>
@@ -72,6 +74,18 @@ struct NewtonParameters {
   int max_iterations = 25;
 };
 
+/// Time integration: `static` (load stepping, the default) or `newmark` (β = 1/4, γ = 1/2)
+/// from u = 0 (Dirichlet values from t = 0), a uniform initial velocity on the free dofs and
+/// the loads applied in full at t = 0.
+struct TimeParameters {
+  bool dynamic = false;
+  double step = 0;                       ///< Δt [s]
+  double end_time = 0;                   ///< [s]
+  int n_steps = 0;                       ///< round(end_time/Δt)
+  std::vector<double> initial_velocity;  ///< [m/s], empty: at rest
+  std::string where;
+};
+
 /// Everything `problem: solid` reads.
 struct SolidParameters {
   mesh::MeshInput mesh;
@@ -82,8 +96,10 @@ struct SolidParameters {
   std::string gravity_where;
   int steps = 1;
   NewtonParameters newton;
+  TimeParameters time;
   std::vector<ProbeParameters> probes;
   bool write_vtk = true;
+  int vtk_interval = 1;  ///< dynamics: VTK every this many time steps
 
   /// Reads and checks every key (InputError located at the key). Vector lengths are checked
   /// against the mesh dimension later (check_dimension).
