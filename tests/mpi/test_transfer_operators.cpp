@@ -16,6 +16,7 @@
 #include <map>
 #include <tuple>
 
+#include "../support/mesh_transforms.hpp"
 #include "coapt/core/context.hpp"
 #include "coapt/mesh/distribute.hpp"
 #include "coapt/mesh/generators.hpp"
@@ -32,27 +33,6 @@ using coapt::transfer::VariationalTransfer;
 
 const MPI_Comm kWorld = MPI_COMM_WORLD;
 
-void rotate(Mesh& m, double angle, std::array<double, 3> u) {
-  const double norm = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-  for (double& a : u) a /= norm;
-  if (m.dim == 2) u = {0, 0, 1};
-  const double c = std::cos(angle), s = std::sin(angle);
-  const double r[3][3] = {{c + u[0] * u[0] * (1 - c), u[0] * u[1] * (1 - c) - u[2] * s,
-                           u[0] * u[2] * (1 - c) + u[1] * s},
-                          {u[1] * u[0] * (1 - c) + u[2] * s, c + u[1] * u[1] * (1 - c),
-                           u[1] * u[2] * (1 - c) - u[0] * s},
-                          {u[2] * u[0] * (1 - c) - u[1] * s, u[2] * u[1] * (1 - c) + u[0] * s,
-                           c + u[2] * u[2] * (1 - c)}};
-  const int d = m.dim;
-  for (int v = 0; v < m.n_vertices(); ++v) {
-    double x[3] = {0, 0, 0}, y[3] = {0, 0, 0};
-    for (int k = 0; k < d; ++k) x[k] = m.coordinates[v * d + k] - 0.5;
-    for (int i = 0; i < d; ++i)
-      for (int k = 0; k < d; ++k) y[i] += r[i][k] * x[k];
-    for (int k = 0; k < d; ++k) m.coordinates[v * d + k] = y[k] + 0.5;
-  }
-}
-
 /// A configuration: whole slave and master meshes (built on every rank, cheap).
 struct Configuration {
   std::string name;
@@ -65,7 +45,7 @@ std::vector<Configuration> configurations() {
        [] { return coapt::mesh::structured_box(0, 0, 0, 1, 1, 1, 10, 10, 10); },
        [] {
          Mesh m = coapt::mesh::structured_box(0.25, 0.25, 0.25, 0.75, 0.75, 0.75, 6, 6, 6);
-         rotate(m, 0.7, {1, 2, 3});
+         m = coapt::testing::rotated(std::move(m), 0.7, {1, 2, 3});
          return m;
        }},
       {"shifted, partly inside (3D)",
@@ -75,7 +55,7 @@ std::vector<Configuration> configurations() {
        [] { return coapt::mesh::structured_rectangle(0, 0, 1, 1, 16, 14); },
        [] {
          Mesh m = coapt::mesh::structured_rectangle(0.2, 0.3, 1.3, 1.2, 23, 17);
-         rotate(m, 0.4, {0, 0, 1});
+         m = coapt::testing::rotated(std::move(m), 0.4, {0, 0, 1});
          return m;
        }},
   };
@@ -228,7 +208,7 @@ TEST(TransferOperatorsParallel, IndependentPartitionsGiveTheSerialOperators) {
 
 TEST(TransferOperatorsParallel, MovingMasterReusesTheSearch) {
   Mesh whole_master = coapt::mesh::structured_box(0.25, 0.25, 0.25, 0.75, 0.75, 0.75, 5, 5, 5);
-  rotate(whole_master, 0.3, {1, 1, 2});
+  whole_master = coapt::testing::rotated(std::move(whole_master), 0.3, {1, 1, 2});
   const Mesh slave =
       distributed(coapt::mesh::structured_box(0, 0, 0, 1, 1, 1, 7, 7, 7), Partitioner::metis);
   Mesh master = distributed(whole_master, Partitioner::blocks);

@@ -39,6 +39,27 @@ Moments<dim> central_moments(double measure, const Point<dim>& center, const Poi
   return m;
 }
 
+/// Where a convex set lies against a half-space, from its vertices.
+enum class Side { inside, outside, cut };
+
+/// Signed distances of `points[0..n)` to the half-space into `distance`, snapped to 0 within
+/// `tolerance` so that a vertex on the plane is treated alike by every clip; says whether the
+/// set is wholly inside (nothing to clip), wholly outside (empty) or cut.
+template <int dim, class Points>
+Side classify(const HalfSpace<dim>& half_space, const Points& points, int n, double tolerance,
+              double* distance) {
+  bool any_inside = false, any_outside = false;
+  for (int k = 0; k < n; ++k) {
+    double d = half_space.distance(points[k]);
+    if (std::fabs(d) <= tolerance) d = 0.0;
+    distance[k] = d;
+    any_inside = any_inside || d > 0.0;
+    any_outside = any_outside || d < 0.0;
+  }
+  if (!any_outside) return Side::inside;
+  return any_inside ? Side::cut : Side::outside;
+}
+
 }  // namespace
 
 // ================================================================================================
@@ -79,16 +100,9 @@ void ConvexPolygon::assign_triangle(const std::array<Point<2>, 3>& vertices) {
 bool ConvexPolygon::clip(const HalfSpace<2>& half_plane, double tolerance) {
   if (n_vertices_ == 0) return false;
   std::array<double, capacity> distance;
-  bool any_inside = false, any_outside = false;
-  for (int k = 0; k < n_vertices_; ++k) {
-    double d = half_plane.distance(vertices_[k]);
-    if (std::fabs(d) <= tolerance) d = 0.0;
-    distance[k] = d;
-    any_inside = any_inside || d > 0.0;
-    any_outside = any_outside || d < 0.0;
-  }
-  if (!any_outside) return true;
-  if (!any_inside) {
+  const Side side = classify<2>(half_plane, vertices_, n_vertices_, tolerance, distance.data());
+  if (side == Side::inside) return true;
+  if (side == Side::outside) {
     n_vertices_ = 0;
     return false;
   }
@@ -231,16 +245,9 @@ void ConvexPolyhedron::assign_tetrahedron(const std::array<Point<3>, 4>& vertice
 
 bool ConvexPolyhedron::clip(const HalfSpace<3>& half_space, double tolerance) {
   if (n_vertices_ == 0) return false;
-  bool any_inside = false, any_outside = false;
-  for (int v = 0; v < n_vertices_; ++v) {
-    double d = half_space.distance(positions_[v]);
-    if (std::fabs(d) <= tolerance) d = 0.0;
-    distances_[v] = d;
-    any_inside = any_inside || d > 0.0;
-    any_outside = any_outside || d < 0.0;
-  }
-  if (!any_outside) return true;
-  if (!any_inside) {
+  const Side side = classify<3>(half_space, positions_, n_vertices_, tolerance, distances_.data());
+  if (side == Side::inside) return true;
+  if (side == Side::outside) {
     n_vertices_ = 0;
     return false;
   }
