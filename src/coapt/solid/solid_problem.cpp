@@ -325,14 +325,96 @@ class SolidProblem final : public run::Problem {
 
   // --- the load-stepping Newton loop ---------------------------------------------------------
 
+  /// What one Newton solve did.
+  struct NewtonReport {
+    int iterations = 0;
+    int linear_iterations = 0;
+    double norm = 0;  ///< final |R|
+  };
+
+  /// Newton on R(u) = 0 from the current u (ghosts current) whose residual norm is
+  /// history.back(): `jacobian()` assembles the tangent into `matrix`, `residual_norm()`
+  /// re-evaluates R(u) into `residual` and returns |R| (+∞ when a cell inverts). Each update
+  /// is halved while it inverts a cell; the update's Dirichlet entries are zeroed so that the
+  /// prescribed dofs stay exactly as set (an iterative solve leaves round-off there). Stops at
+  /// |R| ≤ max(rtol |R0|, atol) or ‖δu‖ ≤ dtol ‖u‖: the residual of a stiff, thin body bottoms
+  /// out at the round-off of the internal forces (ε times element forces that cancel at each
+  /// vertex). `where` names the step in messages, `remedy` what to try when every step inverts
+  /// a cell; `verbose` logs every iteration at info level (else debug). Collective.
+  template <int Dim, class Jacobian, class ResidualNorm>
+  NewtonReport newton_solve(run::RunOutput& output, Vec u, Vec residual, fem::P1Matrix& matrix,
+                            fem::LinearSolver& solver, Jacobian&& jacobian,
+                            ResidualNorm&& residual_norm, std::vector<double>& history,
+                            const std::string& where, const std::string& remedy, bool verbose) {
+    const auto& newton = parameters_.newton;
+    auto rhs = fem::create_vertex_vector(mesh_, Dim);
+    auto update = fem::create_vertex_vector(mesh_, Dim);
+    auto zero = fem::create_vertex_vector(mesh_, Dim);
+    NewtonReport report;
+    report.norm = history.back();
+    const double tolerance =
+        std::max(newton.relative_tolerance * history.front(), newton.absolute_tolerance);
+    bool small_update = false;
+    while (report.norm > tolerance && !small_update) {
+      if (report.iterations == newton.max_iterations)
+        throw ConvergenceError(
+            fmt::format("solid: Newton did not converge in {} within {} iterations: |R| = [{:.3e}] "
+                        "(tolerance {:.3e})",
+                        where, newton.max_iterations, fmt::join(history, ", "), tolerance));
+      ++report.iterations;
+      {
+        ScopedTimer timer(output.timers(), "assemble");
+        jacobian();
+        COAPT_PETSC_CHECK(VecCopy(residual, rhs));
+        COAPT_PETSC_CHECK(VecScale(rhs, -1.0));
+        fem::apply_dirichlet(matrix.mat(), rhs, dirichlet_dofs_, zero);
+      }
+      fem::SolveStats stats;
+      {
+        ScopedTimer timer(output.timers(), "solve");
+        solver.set_operator(matrix.mat());
+        COAPT_PETSC_CHECK(VecSet(update, 0.0));
+        stats = solver.solve(rhs, update);
+      }
+      set_dirichlet<Dim>(update, false);
+      report.linear_iterations += stats.iterations;
+      double step_length = 1.0;
+      COAPT_PETSC_CHECK(VecAXPY(u, step_length, update));
+      fem::update_ghosts(u);
+      report.norm = residual_norm();
+      for (int halving = 0; !std::isfinite(report.norm) && halving < 12; ++halving) {
+        step_length *= 0.5;
+        COAPT_PETSC_CHECK(VecAXPY(u, -step_length, update));
+        fem::update_ghosts(u);
+        report.norm = residual_norm();
+      }
+      if (!std::isfinite(report.norm))
+        throw ConvergenceError(
+            fmt::format("solid: {}: every Newton step inverts a cell (|R| history [{:.3e}]); {}",
+                        where, fmt::join(history, ", "), remedy));
+      history.push_back(report.norm);
+      PetscReal update_norm = 0, u_norm = 0;
+      COAPT_PETSC_CHECK(VecNorm(update, NORM_2, &update_norm));
+      COAPT_PETSC_CHECK(VecNorm(u, NORM_2, &u_norm));
+      small_update = step_length * update_norm <= newton.update_tolerance * u_norm;
+      const std::string line = fmt::format(
+          "{}: newton {}  |R| = {:.6e}  (|R|/|R0| = {:.3e}, |du|/|u| = {:.3e}, step {:g}, {} "
+          "linear its)",
+          where, report.iterations, report.norm, report.norm / history.front(),
+          step_length * update_norm / u_norm, step_length, stats.iterations);
+      if (verbose)
+        log::info("{}", line);
+      else
+        log::debug("{}", line);
+    }
+    return report;
+  }
+
   template <int Dim>
   void solve(run::RunOutput& output) {
     auto u = fem::create_vertex_vector(mesh_, Dim);
     auto external = fem::create_vertex_vector(mesh_, Dim);
     auto residual = fem::create_vertex_vector(mesh_, Dim);
-    auto rhs = fem::create_vertex_vector(mesh_, Dim);
-    auto update = fem::create_vertex_vector(mesh_, Dim);
-    auto zero = fem::create_vertex_vector(mesh_, Dim);
     fem::P1Matrix matrix(mesh_, Dim);
     fem::set_rigid_body_modes(mesh_, matrix.mat());
     // GMRES rather than CG: the tangent is symmetric but loses definiteness near buckling.
@@ -340,7 +422,6 @@ class SolidProblem final : public run::Problem {
     assemble_external_load<Dim>(external);
     log::info("linear solver: {}", solver.describe());
 
-    const auto& newton = parameters_.newton;
     int total_newton = 0, total_linear = 0;
     for (int step = 1; step <= parameters_.steps; ++step) {
       const double factor = static_cast<double>(step) / parameters_.steps;
@@ -363,68 +444,20 @@ class SolidProblem final : public run::Problem {
             fmt::format("solid: load step {}/{}: the prescribed displacements invert a cell", step,
                         parameters_.steps));
       history.push_back(norm);
-      const double tolerance =
-          std::max(newton.relative_tolerance * norm, newton.absolute_tolerance);
-      int iteration = 0;
-      bool small_update = false;
       log::info("step {}/{} (load factor {:.4g}): newton 0  |R| = {:.6e}", step, parameters_.steps,
                 factor, norm);
-      while (norm > tolerance && !small_update) {
-        if (iteration == newton.max_iterations)
-          throw ConvergenceError(fmt::format(
-              "solid: Newton did not converge in load step {}/{} (load factor {:g}) within {} "
-              "iterations: |R| = [{:.3e}] (tolerance {:.3e})",
-              step, parameters_.steps, factor, newton.max_iterations, fmt::join(history, ", "),
-              tolerance));
-        ++iteration;
-        fem::SolveStats stats;
-        {
-          ScopedTimer timer(output.timers(), "assemble");
-          assemble_tangent<Dim>(u, matrix);
-          COAPT_PETSC_CHECK(VecCopy(residual, rhs));
-          COAPT_PETSC_CHECK(VecScale(rhs, -1.0));
-          fem::apply_dirichlet(matrix.mat(), rhs, dirichlet_dofs_, zero);
-        }
-        {
-          ScopedTimer timer(output.timers(), "solve");
-          solver.set_operator(matrix.mat());
-          COAPT_PETSC_CHECK(VecSet(update, 0.0));
-          stats = solver.solve(rhs, update);
-        }
-        total_linear += stats.iterations;
-        // Full Newton step; halved while it inverts a cell (the residual is then +∞).
-        double step_length = 1.0;
-        COAPT_PETSC_CHECK(VecAXPY(u, step_length, update));
-        fem::update_ghosts(u);
-        {
-          ScopedTimer timer(output.timers(), "assemble");
-          norm = assemble_residual<Dim>(u, external, factor, residual);
-        }
-        for (int halving = 0; !std::isfinite(norm) && halving < 12; ++halving) {
-          step_length *= 0.5;
-          COAPT_PETSC_CHECK(VecAXPY(u, -step_length, update));
-          fem::update_ghosts(u);
-          norm = assemble_residual<Dim>(u, external, factor, residual);
-        }
-        if (!std::isfinite(norm))
-          throw ConvergenceError(fmt::format(
-              "solid: load step {}/{}: every Newton step inverts a cell (|R| history [{:.3e}]); "
-              "use more load steps",
-              step, parameters_.steps, fmt::join(history, ", ")));
-        history.push_back(norm);
-        // The residual of a stiff, thin body bottoms out at the round-off of the internal
-        // forces (ε times element forces that cancel at each vertex), so Newton also stops
-        // once the update no longer changes u: ‖δu‖ ≤ dtol ‖u‖.
-        PetscReal update_norm = 0, u_norm = 0;
-        COAPT_PETSC_CHECK(VecNorm(update, NORM_2, &update_norm));
-        COAPT_PETSC_CHECK(VecNorm(u, NORM_2, &u_norm));
-        small_update = step_length * update_norm <= newton.update_tolerance * u_norm;
-        log::info(
-            "step {}/{}: newton {}  |R| = {:.6e}  (|R|/|R0| = {:.3e}, |du|/|u| = {:.3e}, "
-            "step {:g}, {} linear its)",
-            step, parameters_.steps, iteration, norm, norm / history.front(),
-            step_length * update_norm / u_norm, step_length, stats.iterations);
-      }
+      const auto report = newton_solve<Dim>(
+          output, u, residual, matrix, solver, [&] { assemble_tangent<Dim>(u, matrix); },
+          [&] {
+            ScopedTimer timer(output.timers(), "assemble");
+            return assemble_residual<Dim>(u, external, factor, residual);
+          },
+          history,
+          fmt::format("load step {}/{} (load factor {:g})", step, parameters_.steps, factor),
+          "use more load steps", true);
+      const int iteration = report.iterations;
+      norm = report.norm;
+      total_linear += report.linear_iterations;
       total_newton += iteration;
       const auto values = probe_values<Dim>(u);
       auto& series = output.series();
@@ -514,7 +547,6 @@ class SolidProblem final : public run::Problem {
     auto external = fem::create_vertex_vector(mesh_, Dim);
     auto residual = fem::create_vertex_vector(mesh_, Dim);
     auto rhs = fem::create_vertex_vector(mesh_, Dim);
-    auto update = fem::create_vertex_vector(mesh_, Dim);
     auto zero = fem::create_vertex_vector(mesh_, Dim);
     fem::P1Matrix mass(mesh_, Dim);
     fem::P1Matrix matrix(mesh_, Dim);
@@ -661,69 +693,21 @@ class SolidProblem final : public run::Problem {
         norm = residual_norm();
       }
       history.push_back(norm);
-      const double tolerance =
-          std::max(newton.relative_tolerance * norm, newton.absolute_tolerance);
-      int iteration = 0, linear = 0;
-      bool small_update = false;
-      while (norm > tolerance && !small_update) {
-        if (iteration == newton.max_iterations)
-          throw ConvergenceError(fmt::format(
-              "solid: Newton did not converge in time step {} (t = {:g} s) within {} iterations: "
-              "|R| = [{:.3e}] (tolerance {:.3e})",
-              step, t, newton.max_iterations, fmt::join(history, ", "), tolerance));
-        ++iteration;
-        {
-          ScopedTimer timer(output.timers(), "assemble");
-          fem::LocalValues values(u);
-          matrix.assemble([&](int c, double* element) {
-            const auto K = element_tangent<Dim>(geometry<Dim>(c), body(c).material, body(c).fibres,
-                                                nodal<Dim>(values, c));
-            std::copy(K.data(), K.data() + K.size(), element);
-            add_element_mass<Dim>(c, scheme.mass_factor(), element);
-          });
-        }
-        {
-          ScopedTimer timer(output.timers(), "assemble");
-          COAPT_PETSC_CHECK(VecCopy(residual, rhs));
-          COAPT_PETSC_CHECK(VecScale(rhs, -1.0));
-          fem::apply_dirichlet(matrix.mat(), rhs, dirichlet_dofs_, zero);
-        }
-        fem::SolveStats stats;
-        {
-          ScopedTimer timer(output.timers(), "solve");
-          solver.set_operator(matrix.mat());
-          COAPT_PETSC_CHECK(VecSet(update, 0.0));
-          stats = solver.solve(rhs, update);
-        }
-        // An iterative solve leaves round-off-sized values on the eliminated rows; zero them so
-        // that the prescribed dofs stay exactly fixed (v = a = 0 there).
-        set_dirichlet<Dim>(update, false);
-        linear += stats.iterations;
-        double step_length = 1.0;
-        COAPT_PETSC_CHECK(VecAXPY(u, step_length, update));
-        fem::update_ghosts(u);
-        norm = residual_norm();
-        for (int halving = 0; !std::isfinite(norm) && halving < 12; ++halving) {
-          step_length *= 0.5;
-          COAPT_PETSC_CHECK(VecAXPY(u, -step_length, update));
-          fem::update_ghosts(u);
-          norm = residual_norm();
-        }
-        if (!std::isfinite(norm))
-          throw ConvergenceError(fmt::format(
-              "solid: time step {} (t = {:g} s): every Newton step inverts a cell (|R| history "
-              "[{:.3e}]); use a smaller time step",
-              step, t, fmt::join(history, ", ")));
-        history.push_back(norm);
-        PetscReal update_norm = 0, u_norm = 0;
-        COAPT_PETSC_CHECK(VecNorm(update, NORM_2, &update_norm));
-        COAPT_PETSC_CHECK(VecNorm(u, NORM_2, &u_norm));
-        small_update = step_length * update_norm <= newton.update_tolerance * u_norm;
-        log::debug(
-            "time step {}: newton {}  |R| = {:.6e}  (|R|/|R0| = {:.3e}, step {:g}, {} "
-            "linear its)",
-            step, iteration, norm, norm / history.front(), step_length, stats.iterations);
-      }
+      const auto report = newton_solve<Dim>(
+          output, u, residual, matrix, solver,
+          [&] {
+            fem::LocalValues values(u);
+            matrix.assemble([&](int c, double* element) {
+              const auto K = element_tangent<Dim>(geometry<Dim>(c), body(c).material,
+                                                  body(c).fibres, nodal<Dim>(values, c));
+              std::copy(K.data(), K.data() + K.size(), element);
+              add_element_mass<Dim>(c, scheme.mass_factor(), element);
+            });
+          },
+          residual_norm, history, fmt::format("time step {} (t = {:g} s)", step, t),
+          "use a smaller time step", false);
+      const int iteration = report.iterations, linear = report.linear_iterations;
+      norm = report.norm;
       total_newton += iteration;
       total_linear += linear;
       // v_{n+1} = v_n + Δt/2 (a_n + a_{n+1}); `a` holds a(u_{n+1}) from the last residual.
