@@ -1,0 +1,901 @@
+// The solid model: setup (bodies, Dirichlet dofs, loads, probes), assembly of residual and
+// tangent, one Newton routine shared by load steps and Newmark steps, the Newmark state
+// (committed and trial), energies, probes and VTK output.
+#include "coapt/solid/solid_model.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <vector>
+
+#include "coapt/core/context.hpp"
+#include "coapt/core/log.hpp"
+#include "coapt/core/timer.hpp"
+#include "coapt/fem/assembly.hpp"
+#include "coapt/fem/kernels.hpp"
+#include "coapt/fem/linear_solver.hpp"
+#include "coapt/fem/p1.hpp"
+#include "coapt/mesh/mesh_input.hpp"
+#include "coapt/solid/dynamics.hpp"
+#include "coapt/solid/elements.hpp"
+
+namespace coapt::solid {
+namespace detail {
+
+namespace {
+
+/// A probe located in the reference mesh: the rank holding it keeps its cell and λ.
+struct ProbeLocation {
+  int owner = -1;  ///< rank that evaluates it (lowest rank with an owned cell containing it)
+  int cell = -1;   ///< local cell on the owner
+  std::vector<double> barycentric;
+};
+
+/// Applies `operation(k)` for every owned entry k of the vectors, with raw arrays.
+template <class Operation>
+void for_each_owned(Vec vector, Operation&& operation) {
+  PetscInt n_local = 0;
+  COAPT_PETSC_CHECK(VecGetLocalSize(vector, &n_local));
+  for (PetscInt k = 0; k < n_local; ++k) operation(k);
+}
+
+/// Read-only and writable views of a PETSc vector's owned entries (RAII).
+class ReadArray {
+ public:
+  explicit ReadArray(Vec vector) : vector_(vector) {
+    COAPT_PETSC_CHECK(VecGetArrayRead(vector_, &data_));
+  }
+  ~ReadArray() { VecRestoreArrayRead(vector_, &data_); }
+  ReadArray(const ReadArray&) = delete;
+  ReadArray& operator=(const ReadArray&) = delete;
+  double operator[](PetscInt k) const { return data_[k]; }
+
+ private:
+  Vec vector_;
+  const PetscScalar* data_ = nullptr;
+};
+
+class WriteArray {
+ public:
+  explicit WriteArray(Vec vector) : vector_(vector) {
+    COAPT_PETSC_CHECK(VecGetArray(vector_, &data_));
+  }
+  ~WriteArray() { VecRestoreArray(vector_, &data_); }
+  WriteArray(const WriteArray&) = delete;
+  WriteArray& operator=(const WriteArray&) = delete;
+  double& operator[](PetscInt k) { return data_[k]; }
+
+ private:
+  Vec vector_;
+  PetscScalar* data_ = nullptr;
+};
+
+}  // namespace
+
+class SolidModelImpl {
+ public:
+  SolidModelImpl(const config::Section& root, MPI_Comm comm)
+      : parameters_(SolidParameters::read(root)),
+        comm_(comm),
+        mesh_(mesh::load_mesh(parameters_.mesh, comm, &quality_)),
+        dim_(mesh_.dim),
+        u_(fem::create_vertex_vector(mesh_, dim_)),
+        v_(fem::create_vertex_vector(mesh_, dim_)),
+        a_(fem::create_vertex_vector(mesh_, dim_)),
+        u_committed_(fem::create_vertex_vector(mesh_, dim_)),
+        v_committed_(fem::create_vertex_vector(mesh_, dim_)),
+        a_committed_(fem::create_vertex_vector(mesh_, dim_)),
+        external_(fem::create_vertex_vector(mesh_, dim_)),
+        residual_(fem::create_vertex_vector(mesh_, dim_)),
+        inertia_(fem::create_vertex_vector(mesh_, dim_)),
+        matrix_(mesh_, dim_),
+        solver_(comm_, "solid_",
+                // Quasi-static: GMRES rather than CG (the tangent is symmetric but loses
+                // definiteness near buckling) with GAMG given the rigid-body modes. Dynamic:
+                // a direct solver, since every Newton iteration of every step factors a new
+                // matrix anyway and on thin bodies (the Turek–Hron bar) GMRES + GAMG needs
+                // hundreds of iterations per solve; -solid_ksp_type gmres -solid_pc_type gamg
+                // brings the iterative solver back.
+                parameters_.time.dynamic
+                    ? fem::LinearSolverDefaults{"preonly", "lu", 1e-10, 1e-50, 2000}
+                    : fem::LinearSolverDefaults{"gmres", "gamg", 1e-10, 1e-50, 2000}) {
+    MPI_Comm_rank(comm_, &rank_);
+    parameters_.check_dimension(dim_);
+    assign_bodies();
+    collect_dirichlet();
+    locate_probes();
+    fem::set_rigid_body_modes(mesh_, matrix_.mat());
+    if (parameters_.time.dynamic) {
+      PetscBool given = PETSC_FALSE;
+      COAPT_PETSC_CHECK(
+          PetscOptionsHasName(nullptr, "solid_", "-pc_factor_mat_solver_type", &given));
+      PC pc = nullptr;
+      COAPT_PETSC_CHECK(KSPGetPC(solver_.ksp(), &pc));
+      if (!given) COAPT_PETSC_CHECK(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+    }
+    if (dim_ == 2)
+      assemble_external_load<2>();
+    else
+      assemble_external_load<3>();
+    set_dirichlet(u_, 1.0);
+    fem::update_ghosts(u_);
+  }
+
+  void describe() const {
+    log::info("solid: {} finite strain, P1 {}, {}",
+              parameters_.time.dynamic ? "dynamic" : "quasi-static",
+              dim_ == 2 ? "plane strain" : "3D", parameters_.mesh.describe());
+    log::info("mesh: {} cells, {} vertices, {} rank(s); cell measure in [{:.3e}, {:.3e}]",
+              mesh_.n_global_cells, mesh_.n_global_vertices, size_of(comm_), quality_.min_measure,
+              quality_.max_measure);
+    for (const auto& body : parameters_.bodies)
+      log::info("body '{}': {}, density {:g} kg/m^3", body.name, name(body.material), body.density);
+    if (density_offset_ != 0)
+      log::info("inertia density: body density - {:g} kg/m^3", density_offset_);
+    if (parameters_.time.dynamic)
+      log::info("Newmark (beta 1/4, gamma 1/2): {} steps of {:g} s to t = {:g} s",
+                parameters_.time.n_steps, parameters_.time.step, parameters_.time.end_time);
+    else
+      log::info("{} load step(s)", parameters_.steps);
+    log::info("Newton: relative tolerance {:g}, absolute {:g}, update {:g}, at most {} its",
+              parameters_.newton.relative_tolerance, parameters_.newton.absolute_tolerance,
+              parameters_.newton.update_tolerance, parameters_.newton.max_iterations);
+    log::info("linear solver: {}", solver_.describe());
+  }
+
+  // --- access -------------------------------------------------------------------------------
+
+  const SolidParameters& parameters() const { return parameters_; }
+  MPI_Comm comm() const { return comm_; }
+  const mesh::Mesh& mesh() const { return mesh_; }
+  const mesh::QualityReport& quality() const { return quality_; }
+  int dim() const { return dim_; }
+  const std::vector<int>& body_of_cell() const { return body_of_cell_; }
+  const std::vector<PetscInt>& dirichlet_dofs() const { return dirichlet_dofs_; }
+  Vec displacement() const { return u_.get(); }
+  Vec velocity() const { return v_.get(); }
+  Vec acceleration() const { return a_.get(); }
+  void set_external_force(Vec force) { extra_force_ = force; }
+  void set_hook(NewtonHook* hook) { hook_ = hook; }
+
+  void set_density_offset(double offset) {
+    for (const auto& body : parameters_.bodies)
+      if (body.density - offset < 0)
+        throw InputError(fmt::format(
+            "{}: density: {:g} kg/m^3 is below the density {:g} kg/m^3 the body is immersed in",
+            body.where, body.density, offset));
+    density_offset_ = offset;
+  }
+
+  // --- quasi-static ---------------------------------------------------------------------------
+
+  StepReport solve_static(double factor, run::RunOutput& output, const std::string& label,
+                          bool verbose) {
+    set_dirichlet(u_, factor);
+    fem::update_ghosts(u_);
+    const auto residual_norm = [&] {
+      ScopedTimer timer(output.timers(), "assemble");
+      return assemble_residual(u_.get(), factor, nullptr);
+    };
+    StepReport report;
+    if (hook_) hook_->begin_step(u_.get());
+    const double norm = residual_norm();
+    if (!std::isfinite(norm))
+      throw ConvergenceError(
+          fmt::format("solid: {}: the prescribed displacements invert a cell", label));
+    report.history.push_back(norm);
+    if (verbose) log::info("{}: newton 0  |R| = {:.6e}", label, norm);
+    newton_solve(
+        output, report, [&] { assemble_tangent(u_.get(), 0.0); }, residual_norm, label,
+        "use more load steps", verbose);
+    return report;
+  }
+
+  // --- dynamics -------------------------------------------------------------------------------
+
+  bool has_mass() const {
+    for (const auto& body : parameters_.bodies)
+      if (body.density - density_offset_ > 0) return true;
+    return false;
+  }
+
+  void assemble_mass() {
+    mass_.emplace(mesh_, dim_);
+    mass_->assemble([&](int c, double* element) {
+      const int n = (dim_ + 1) * dim_;
+      std::fill(element, element + n * n, 0.0);
+      add_element_mass(c, 1.0, element);
+    });
+  }
+
+  void initialize_dynamics(run::RunOutput& output) {
+    assemble_mass();
+    COAPT_PETSC_CHECK(VecSet(u_, 0.0));
+    set_dirichlet(u_, 1.0);
+    fem::update_ghosts(u_);
+    {
+      const auto& initial = parameters_.time.initial_velocity;
+      WriteArray v(v_);
+      for_each_owned(v_, [&](PetscInt k) { v[k] = initial.empty() ? 0.0 : initial[k % dim_]; });
+    }
+    zero_dirichlet(v_);
+    fem::update_ghosts(v_);
+    COAPT_PETSC_CHECK(VecSet(a_, 0.0));
+    // M a₀ = f_ext − f_int(u₀) on the free dofs, a₀ = 0 on the Dirichlet ones.
+    const double norm = assemble_residual(u_.get(), 1.0, nullptr);
+    if (!std::isfinite(norm))
+      throw ConvergenceError("solid: the prescribed displacements invert a cell at t = 0");
+    if (has_mass()) {
+      ScopedTimer timer(output.timers(), "solve");
+      auto rhs = fem::create_vertex_vector(mesh_, dim_);
+      auto zero = fem::create_vertex_vector(mesh_, dim_);
+      matrix_.assemble([&](int c, double* element) {
+        const int n = (dim_ + 1) * dim_;
+        std::fill(element, element + n * n, 0.0);
+        add_element_mass(c, 1.0, element);
+      });
+      COAPT_PETSC_CHECK(VecCopy(residual_, rhs));
+      COAPT_PETSC_CHECK(VecScale(rhs, -1.0));
+      fem::apply_dirichlet(matrix_.mat(), rhs, dirichlet_dofs_, zero);
+      solver_.set_operator(matrix_.mat());
+      solver_.solve(rhs, a_);
+      zero_dirichlet(a_);
+    }
+    fem::update_ghosts(a_);
+    commit();
+  }
+
+  StepReport step(double time, double time_step, run::RunOutput& output) {
+    if (!mass_) throw InternalError("solid: step() before initialize_dynamics()");
+    const Newmark scheme{time_step};
+    const std::string label = fmt::format("time step to t = {:g} s", time);
+    {  // predictor u = uₙ + Δt vₙ + Δt²/2 aₙ (Dirichlet dofs: v = a = 0, u stays)
+      WriteArray u(u_);
+      ReadArray un(u_committed_), vn(v_committed_), an(a_committed_);
+      for_each_owned(u_, [&](PetscInt k) { u[k] = scheme.predictor(un[k], vn[k], an[k]); });
+    }
+    fem::update_ghosts(u_);
+    const auto residual_norm = [&] {
+      update_acceleration(scheme);
+      ScopedTimer timer(output.timers(), "assemble");
+      return assemble_residual(u_.get(), 1.0, inertia_.get());
+    };
+    StepReport report;
+    if (hook_) hook_->begin_step(u_.get());
+    double norm = residual_norm();
+    if (!std::isfinite(norm)) {  // the predictor inverts a cell: start from uₙ instead
+      COAPT_PETSC_CHECK(VecCopy(u_committed_, u_));
+      fem::update_ghosts(u_);
+      norm = residual_norm();
+    }
+    report.history.push_back(norm);
+    newton_solve(
+        output, report, [&] { assemble_tangent(u_.get(), scheme.mass_factor()); }, residual_norm,
+        label, "use a smaller time step", false);
+    {  // v = vₙ + Δt/2 (aₙ + a); `a_` holds a(u) from the last residual
+      WriteArray v(v_);
+      ReadArray vn(v_committed_), an(a_committed_), a(a_);
+      for_each_owned(v_, [&](PetscInt k) { v[k] = scheme.velocity(vn[k], an[k], a[k]); });
+    }
+    fem::update_ghosts(v_);
+    fem::update_ghosts(a_);
+    return report;
+  }
+
+  void commit() {
+    COAPT_PETSC_CHECK(VecCopy(u_, u_committed_));
+    COAPT_PETSC_CHECK(VecCopy(v_, v_committed_));
+    COAPT_PETSC_CHECK(VecCopy(a_, a_committed_));
+  }
+
+  void restore() {
+    COAPT_PETSC_CHECK(VecCopy(u_committed_, u_));
+    COAPT_PETSC_CHECK(VecCopy(v_committed_, v_));
+    COAPT_PETSC_CHECK(VecCopy(a_committed_, a_));
+    fem::update_ghosts(u_);
+    fem::update_ghosts(v_);
+    fem::update_ghosts(a_);
+  }
+
+  // --- reported quantities --------------------------------------------------------------------
+
+  std::vector<std::vector<double>> probe_values() const {
+    std::vector<std::vector<double>> result;
+    fem::LocalValues values(u_.get());
+    for (const auto& probe : probes_) {
+      std::vector<double> value(static_cast<std::size_t>(dim_), 0.0);
+      if (probe.owner == rank_) {
+        const auto vertices = mesh_.cell(probe.cell);
+        for (int a = 0; a <= dim_; ++a)
+          for (int i = 0; i < dim_; ++i)
+            value[i] +=
+                probe.barycentric[a] * values[static_cast<std::size_t>(vertices[a]) * dim_ + i];
+      }
+      MPI_Bcast(value.data(), dim_, MPI_DOUBLE, probe.owner, comm_);
+      result.push_back(std::move(value));
+    }
+    return result;
+  }
+
+  double kinetic_energy() const {
+    if (!mass_) return 0.0;
+    auto product = fem::create_vertex_vector(mesh_, dim_);
+    COAPT_PETSC_CHECK(MatMult(mass_->mat(), v_, product));
+    PetscScalar twice = 0;
+    COAPT_PETSC_CHECK(VecDot(v_, product, &twice));
+    return 0.5 * twice;
+  }
+
+  double external_work() const {
+    PetscScalar work = 0;
+    COAPT_PETSC_CHECK(VecDot(external_, u_, &work));
+    return work;
+  }
+
+  double strain_energy() const {
+    return dim_ == 2 ? cell_integral<2>(Integrand::energy) : cell_integral<3>(Integrand::energy);
+  }
+
+  double volume() const {
+    return dim_ == 2 ? cell_integral<2>(Integrand::volume) : cell_integral<3>(Integrand::volume);
+  }
+
+  std::vector<double> current_coordinates() const {
+    fem::LocalValues values(u_.get());
+    std::vector<double> coordinates = mesh_.coordinates;
+    for (std::size_t k = 0; k < coordinates.size(); ++k) coordinates[k] += values[k];
+    return coordinates;
+  }
+
+  void write_vtk(run::RunOutput& output, double time, const std::vector<io::Field>& extra) const {
+    if (dim_ == 2)
+      write_vtk<2>(output, time, extra);
+    else
+      write_vtk<3>(output, time, extra);
+  }
+
+ private:
+  // --- setup -------------------------------------------------------------------------------
+
+  /// body_of_cell_[c] for every local cell; an InputError (on every rank) if an owned cell
+  /// has no body or a group is not a cell group of the mesh.
+  void assign_bodies() {
+    body_of_cell_.assign(static_cast<std::size_t>(mesh_.n_cells()), -1);
+    int catch_all = -1;
+    for (std::size_t b = 0; b < parameters_.bodies.size(); ++b) {
+      const auto& body = parameters_.bodies[b];
+      if (body.cell_groups.empty()) catch_all = static_cast<int>(b);
+      for (const auto& name : body.cell_groups) {
+        const auto& group = mesh_.group(name);
+        if (group.dim != dim_)
+          throw InputError(fmt::format("{}: cell_groups: '{}' is not a cell group of {}",
+                                       body.where, name, mesh_.source));
+        for (int c = 0; c < mesh_.n_cells(); ++c)
+          if (mesh_.cell_tags[c] == group.tag) body_of_cell_[c] = static_cast<int>(b);
+      }
+    }
+    long unassigned = 0;
+    for (int c = 0; c < mesh_.n_cells(); ++c)
+      if (body_of_cell_[c] < 0) {
+        if (catch_all >= 0)
+          body_of_cell_[c] = catch_all;
+        else if (c < mesh_.n_owned_cells)
+          ++unassigned;
+      }
+    MPI_Allreduce(MPI_IN_PLACE, &unassigned, 1, MPI_LONG, MPI_SUM, comm_);
+    if (unassigned > 0)
+      throw InputError(
+          fmt::format("{}: {} cell(s) of {} belong to no body (list their groups in "
+                      "cell_groups, or leave one body without cell_groups)",
+                      parameters_.bodies.front().where, unassigned, mesh_.source));
+  }
+
+  int facet_tag(const std::string& name, const std::string& where) const {
+    const auto* group = mesh_.find_group(name);
+    if (!group || group->dim != dim_ - 1) {
+      std::string names;
+      for (const auto& g : mesh_.groups)
+        if (g.dim == dim_ - 1) names += (names.empty() ? "" : ", ") + g.name;
+      throw InputError(fmt::format("{}: no boundary group '{}' in {} (it has: {})", where, name,
+                                   mesh_.source, names.empty() ? "none" : names));
+    }
+    return group->tag;
+  }
+
+  /// The owned Dirichlet dofs with their final values (a later condition wins on a dof).
+  void collect_dirichlet() {
+    std::vector<std::pair<PetscInt, double>> prescribed;
+    for (const auto& condition : parameters_.dirichlet) {
+      const int tag = facet_tag(condition.boundary, condition.where);
+      std::vector<int> components = condition.components;
+      if (components.empty())
+        for (int i = 0; i < dim_; ++i) components.push_back(i);
+      for (std::size_t k = 0; k < components.size(); ++k) {
+        const int component[1] = {components[k]};
+        const double value = condition.values.empty() ? 0.0 : condition.values[k];
+        for (PetscInt dof : fem::boundary_dofs(mesh_, dim_, tag, component))
+          prescribed.emplace_back(dof, value);
+      }
+    }
+    std::stable_sort(prescribed.begin(), prescribed.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (std::size_t i = 0; i < prescribed.size(); ++i) {
+      if (i + 1 < prescribed.size() && prescribed[i + 1].first == prescribed[i].first) continue;
+      dirichlet_dofs_.push_back(prescribed[i].first);
+      dirichlet_values_.push_back(prescribed[i].second);
+    }
+  }
+
+  /// Barycentric coordinates of `point` in local cell c.
+  std::vector<double> barycentric(int c, const std::vector<double>& point) const {
+    Eigen::MatrixXd system(dim_ + 1, dim_ + 1);
+    Eigen::VectorXd rhs(dim_ + 1);
+    const auto vertices = mesh_.cell(c);
+    for (int a = 0; a <= dim_; ++a) {
+      system(0, a) = 1.0;
+      for (int d = 0; d < dim_; ++d) system(d + 1, a) = mesh_.point(vertices[a])[d];
+    }
+    rhs(0) = 1.0;
+    for (int d = 0; d < dim_; ++d) rhs(d + 1) = point[d];
+    const Eigen::VectorXd lambda = system.partialPivLu().solve(rhs);
+    return {lambda.data(), lambda.data() + lambda.size()};
+  }
+
+  /// Finds, for each probe, the lowest rank with an owned cell containing it. Collective.
+  void locate_probes() {
+    constexpr double tolerance = 1e-10;
+    for (const auto& probe : parameters_.probes) {
+      ProbeLocation location;
+      for (int c = 0; c < mesh_.n_owned_cells && location.cell < 0; ++c) {
+        auto lambda = barycentric(c, probe.point);
+        if (*std::min_element(lambda.begin(), lambda.end()) >= -tolerance) {
+          location.cell = c;
+          location.barycentric = std::move(lambda);
+        }
+      }
+      int candidate = location.cell >= 0 ? rank_ : std::numeric_limits<int>::max();
+      MPI_Allreduce(&candidate, &location.owner, 1, MPI_INT, MPI_MIN, comm_);
+      if (location.owner == std::numeric_limits<int>::max())
+        throw InputError(fmt::format("{}: point ({}) lies in no cell of {}", probe.where,
+                                     fmt::join(probe.point, ", "), mesh_.source));
+      probes_.push_back(std::move(location));
+    }
+  }
+
+  /// Sets the Dirichlet dofs of `vector` to factor × their values. Ghosts not updated.
+  void set_dirichlet(Vec vector, double factor) {
+    WriteArray data(vector);
+    for (std::size_t k = 0; k < dirichlet_dofs_.size(); ++k)
+      data[dirichlet_dofs_[k] - mesh_.vertex_offset * dim_] = factor * dirichlet_values_[k];
+  }
+  void zero_dirichlet(Vec vector) { set_dirichlet(vector, 0.0); }
+
+  // --- assembly ------------------------------------------------------------------------------
+
+  template <int Dim>
+  fem::P1Geometry<Dim> geometry(int c) const {
+    const double* points[Dim + 1];
+    for (int a = 0; a <= Dim; ++a) points[a] = mesh_.point(mesh_.cell(c)[a]).data();
+    return fem::p1_geometry<Dim>(points);
+  }
+
+  template <int Dim>
+  NodalValues<Dim> nodal(const fem::LocalValues& u, int c) const {
+    NodalValues<Dim> values;
+    const auto vertices = mesh_.cell(c);
+    for (int a = 0; a <= Dim; ++a)
+      for (int i = 0; i < Dim; ++i)
+        values(a, i) = u[static_cast<std::size_t>(vertices[a]) * Dim + i];
+    return values;
+  }
+
+  const BodyParameters& body(int c) const { return parameters_.bodies[body_of_cell_[c]]; }
+
+  /// The full external load f_ext (gravity and tractions at load factor 1). Collective.
+  template <int Dim>
+  void assemble_external_load() {
+    using VectorD = Eigen::Matrix<double, Dim, 1>;
+    VectorD gravity = VectorD::Zero();
+    for (std::size_t d = 0; d < parameters_.gravity.size(); ++d)
+      gravity(d) = parameters_.gravity[d];
+    // Tractions: per load, the owned-cell facets of its group (each facet counted once) and,
+    // for a total force, the group's reference measure.
+    std::vector<std::pair<int, VectorD>> facet_loads;  // facet, traction
+    for (const auto& load : parameters_.tractions) {
+      const int tag = facet_tag(load.boundary, load.where);
+      double measure = 0;
+      std::vector<int> facets;
+      for (int f = 0; f < mesh_.n_facets(); ++f)
+        if (mesh_.facet_tags[f] == tag && mesh_.facet_cell[f] < mesh_.n_owned_cells) {
+          facets.push_back(f);
+          measure += facet_measure<Dim>(f);
+        }
+      MPI_Allreduce(MPI_IN_PLACE, &measure, 1, MPI_DOUBLE, MPI_SUM, comm_);
+      VectorD traction;
+      for (int d = 0; d < Dim; ++d) traction(d) = load.vector[d];
+      if (load.total) traction /= measure;
+      log::info("traction on '{}' (measure {:.6g}): ({:.6g}) {}", load.boundary, measure,
+                fmt::join(traction.data(), traction.data() + Dim, ", "), Dim == 2 ? "N/m^2" : "Pa");
+      for (int f : facets) facet_loads.emplace_back(f, traction);
+    }
+    Vec load = external_.get();
+    Vec local = nullptr;
+    COAPT_PETSC_CHECK(VecSet(load, 0.0));
+    COAPT_PETSC_CHECK(VecGhostGetLocalForm(load, &local));
+    PetscScalar* data = nullptr;
+    COAPT_PETSC_CHECK(VecGetArray(local, &data));
+    for (int c = 0; c < mesh_.n_owned_cells; ++c) {
+      const VectorD f =
+          uniform_nodal_load<Dim>(body(c).density * gravity, geometry<Dim>(c).measure, Dim + 1);
+      for (int v : mesh_.cell(c))
+        for (int i = 0; i < Dim; ++i) data[static_cast<std::size_t>(v) * Dim + i] += f(i);
+    }
+    for (const auto& [f, traction] : facet_loads) {
+      const VectorD nodal_force = uniform_nodal_load<Dim>(traction, facet_measure<Dim>(f), Dim);
+      for (int a = 0; a < Dim; ++a)
+        for (int i = 0; i < Dim; ++i)
+          data[static_cast<std::size_t>(mesh_.facets[static_cast<std::size_t>(f) * Dim + a]) * Dim +
+               i] += nodal_force(i);
+    }
+    COAPT_PETSC_CHECK(VecRestoreArray(local, &data));
+    COAPT_PETSC_CHECK(VecGhostRestoreLocalForm(load, &local));
+    fem::add_local_to_global(load);
+  }
+
+  template <int Dim>
+  double facet_measure(int f) const {
+    const int* v = mesh_.facets.data() + static_cast<std::size_t>(f) * Dim;
+    if constexpr (Dim == 2) {
+      const auto p = mesh_.point(v[0]), q = mesh_.point(v[1]);
+      return std::hypot(q[0] - p[0], q[1] - p[1]);
+    } else {
+      Eigen::Vector3d p, q, r;
+      for (int d = 0; d < 3; ++d) {
+        p(d) = mesh_.point(v[0])[d];
+        q(d) = mesh_.point(v[1])[d];
+        r(d) = mesh_.point(v[2])[d];
+      }
+      return 0.5 * (q - p).cross(r - p).norm();
+    }
+  }
+
+  /// R = f_int(u) − s f_ext − f_extra (+ M a when `inertia` holds M a) + the hook's terms into
+  /// residual_ with the Dirichlet rows zeroed; returns ‖R‖₂, or +∞ when some cell is inverted
+  /// (det F ≤ 0 or not finite) on any rank. Collective.
+  double assemble_residual(Vec u, double factor, Vec inertia) {
+    return dim_ == 2 ? assemble_residual<2>(u, factor, inertia)
+                     : assemble_residual<3>(u, factor, inertia);
+  }
+
+  template <int Dim>
+  double assemble_residual(Vec u, double factor, Vec inertia) {
+    double min_J = std::numeric_limits<double>::infinity();
+    {
+      fem::LocalValues values(u);
+      fem::assemble_vector(mesh_, Dim, residual_, [&](int c, double* element) {
+        const auto g = geometry<Dim>(c);
+        const NodalValues<Dim> displacement = nodal<Dim>(values, c);
+        const double J = deformation_gradient<Dim>(g.gradients, displacement).determinant();
+        min_J = std::isfinite(J) ? std::min(min_J, J) : -1.0;
+        if (!(J > 0.0)) return;  // the whole residual is rejected below
+        const auto r = element_residual<Dim>(g, body(c).material, body(c).fibres, displacement);
+        std::copy(r.data(), r.data() + r.size(), element);
+      });
+    }
+    MPI_Allreduce(MPI_IN_PLACE, &min_J, 1, MPI_DOUBLE, MPI_MIN, comm_);
+    if (!(min_J > 0.0)) return std::numeric_limits<double>::infinity();
+    COAPT_PETSC_CHECK(VecAXPY(residual_, -factor, external_));
+    if (extra_force_) COAPT_PETSC_CHECK(VecAXPY(residual_, -1.0, extra_force_));
+    if (inertia) COAPT_PETSC_CHECK(VecAXPY(residual_, 1.0, inertia));
+    if (hook_) hook_->add_residual(u, residual_);
+    zero_dirichlet(residual_);
+    PetscReal norm = 0;
+    COAPT_PETSC_CHECK(VecNorm(residual_, NORM_2, &norm));
+    return std::isfinite(norm) ? norm : std::numeric_limits<double>::infinity();
+  }
+
+  /// K(u) + mass_factor M into matrix_. Collective.
+  void assemble_tangent(Vec u, double mass_factor) {
+    if (dim_ == 2)
+      assemble_tangent<2>(u, mass_factor);
+    else
+      assemble_tangent<3>(u, mass_factor);
+  }
+
+  template <int Dim>
+  void assemble_tangent(Vec u, double mass_factor) {
+    fem::LocalValues values(u);
+    matrix_.assemble([&](int c, double* element) {
+      const auto K = element_tangent<Dim>(geometry<Dim>(c), body(c).material, body(c).fibres,
+                                          nodal<Dim>(values, c));
+      std::copy(K.data(), K.data() + K.size(), element);
+      if (mass_factor != 0) add_element_mass(c, mass_factor, element);
+    });
+  }
+
+  /// Adds scale (ρ_body − ρ_offset) M_ab δ_ij (consistent P1 mass, node-major) of cell c.
+  void add_element_mass(int c, double scale, double* element) const {
+    const double density = body(c).density - density_offset_;
+    if (density == 0) return;
+    if (dim_ == 2)
+      add_element_mass<2>(c, scale * density, element);
+    else
+      add_element_mass<3>(c, scale * density, element);
+  }
+
+  template <int Dim>
+  void add_element_mass(int c, double factor, double* element) const {
+    constexpr int n = (Dim + 1) * Dim;
+    const auto mass = fem::element_mass<Dim>(geometry<Dim>(c));
+    for (int a = 0; a <= Dim; ++a)
+      for (int b = 0; b <= Dim; ++b)
+        for (int i = 0; i < Dim; ++i)
+          element[(a * Dim + i) * n + b * Dim + i] += factor * mass(a, b);
+  }
+
+  /// a(u) into a_ and M a(u) into inertia_, from u_ and the committed state.
+  void update_acceleration(const Newmark& scheme) {
+    {
+      WriteArray a(a_);
+      ReadArray u(u_), un(u_committed_), vn(v_committed_), an(a_committed_);
+      for_each_owned(a_,
+                     [&](PetscInt k) { a[k] = scheme.acceleration(u[k], un[k], vn[k], an[k]); });
+    }
+    COAPT_PETSC_CHECK(MatMult(mass_->mat(), a_, inertia_));
+  }
+
+  enum class Integrand { energy, volume };
+
+  /// ∫ ψ(F) dX or ∫ det F dX over the owned cells, summed over ranks. Collective.
+  template <int Dim>
+  double cell_integral(Integrand integrand) const {
+    fem::LocalValues values(u_.get());
+    double sum = 0;
+    for (int c = 0; c < mesh_.n_owned_cells; ++c) {
+      const auto g = geometry<Dim>(c);
+      const MatrixD<Dim> F = deformation_gradient<Dim>(g.gradients, nodal<Dim>(values, c));
+      if (integrand == Integrand::volume)
+        sum += g.measure * F.determinant();
+      else if constexpr (Dim == 2)
+        sum += g.measure * plane_strain::energy(body(c).material, F, body(c).fibres);
+      else
+        sum += g.measure * solid::energy(body(c).material, F, body(c).fibres);
+    }
+    MPI_Allreduce(MPI_IN_PLACE, &sum, 1, MPI_DOUBLE, MPI_SUM, comm_);
+    return sum;
+  }
+
+  // --- Newton --------------------------------------------------------------------------------
+
+  /// Newton on R(u_) = 0 from the current u_ (ghosts current) whose residual norm is
+  /// report.history.back(): `jacobian()` assembles the tangent into matrix_,
+  /// `residual_norm()` re-evaluates R(u_) into residual_ and returns |R| (+∞ when a cell
+  /// inverts). Each update is halved while it inverts a cell; the update's Dirichlet entries
+  /// are zeroed so that the prescribed dofs stay exactly as set (an iterative solve leaves
+  /// round-off there). Stops at |R| ≤ max(rtol |R0|, atol) or ‖δu‖ ≤ dtol ‖u‖ (the residual of
+  /// a stiff, thin body bottoms out at the round-off of the internal forces: ε times element
+  /// forces that cancel at each vertex), and when the hook accepts. `where` names the step
+  /// in messages, `remedy` what to try when every step inverts a cell; `verbose` logs every
+  /// iteration at info level (else debug). Collective.
+  template <class Jacobian, class ResidualNorm>
+  void newton_solve(run::RunOutput& output, StepReport& report, Jacobian&& jacobian,
+                    ResidualNorm&& residual_norm, const std::string& where,
+                    const std::string& remedy, bool verbose) {
+    const auto& newton = parameters_.newton;
+    auto rhs = fem::create_vertex_vector(mesh_, dim_);
+    auto update = fem::create_vertex_vector(mesh_, dim_);
+    auto zero = fem::create_vertex_vector(mesh_, dim_);
+    auto& history = report.history;
+    double norm = history.back();
+    const double tolerance =
+        std::max(newton.relative_tolerance * history.front(), newton.absolute_tolerance);
+    bool small_update = false, accepted = !hook_ || hook_->accept(u_.get());
+    while ((norm > tolerance && !small_update) || !accepted) {
+      if (report.newton_iterations == newton.max_iterations)
+        throw ConvergenceError(
+            fmt::format("solid: Newton did not converge in {} within {} iterations: |R| = [{:.3e}] "
+                        "(tolerance {:.3e})",
+                        where, newton.max_iterations, fmt::join(history, ", "), tolerance));
+      ++report.newton_iterations;
+      Mat system = nullptr;
+      {
+        ScopedTimer timer(output.timers(), "assemble");
+        jacobian();
+        COAPT_PETSC_CHECK(VecCopy(residual_, rhs));
+        COAPT_PETSC_CHECK(VecScale(rhs, -1.0));
+        fem::apply_dirichlet(matrix_.mat(), rhs, dirichlet_dofs_, zero);
+        system = hook_ ? hook_->linear_system(u_.get(), matrix_.mat(), rhs) : matrix_.mat();
+      }
+      fem::SolveStats stats;
+      {
+        ScopedTimer timer(output.timers(), "solve");
+        solver_.set_operator(system);
+        COAPT_PETSC_CHECK(VecSet(update, 0.0));
+        stats = solver_.solve(rhs, update);
+      }
+      zero_dirichlet(update);
+      report.linear_iterations += stats.iterations;
+      double step_length = 1.0;
+      COAPT_PETSC_CHECK(VecAXPY(u_, step_length, update));
+      fem::update_ghosts(u_);
+      norm = residual_norm();
+      for (int halving = 0; !std::isfinite(norm) && halving < 12; ++halving) {
+        step_length *= 0.5;
+        COAPT_PETSC_CHECK(VecAXPY(u_, -step_length, update));
+        fem::update_ghosts(u_);
+        norm = residual_norm();
+      }
+      if (!std::isfinite(norm))
+        throw ConvergenceError(
+            fmt::format("solid: {}: every Newton step inverts a cell (|R| history [{:.3e}]); {}",
+                        where, fmt::join(history, ", "), remedy));
+      history.push_back(norm);
+      accepted = !hook_ || hook_->accept(u_.get());
+      PetscReal update_norm = 0, u_norm = 0;
+      COAPT_PETSC_CHECK(VecNorm(update, NORM_2, &update_norm));
+      COAPT_PETSC_CHECK(VecNorm(u_, NORM_2, &u_norm));
+      small_update = step_length * update_norm <= newton.update_tolerance * u_norm;
+      const std::string line = fmt::format(
+          "{}: newton {}  |R| = {:.6e}  (|R|/|R0| = {:.3e}, |du|/|u| = {:.3e}, step {:g}, {} "
+          "linear its)",
+          where, report.newton_iterations, norm, norm / history.front(),
+          step_length * update_norm / u_norm, step_length, stats.iterations);
+      if (verbose)
+        log::info("{}", line);
+      else
+        log::debug("{}", line);
+    }
+  }
+
+  // --- output --------------------------------------------------------------------------------
+
+  /// Displacement and velocity (vertices), Cauchy stress (3×3 per cell, σ₃₃ included in plane
+  /// strain), von Mises stress, det F and body (cells), plus `extra`. Collective.
+  template <int Dim>
+  void write_vtk(run::RunOutput& output, double time, const std::vector<io::Field>& extra) const {
+    ScopedTimer timer(output.timers(), "output");
+    fem::LocalValues values(u_.get());
+    fem::LocalValues velocities(v_.get());
+    const std::size_t n_cells = static_cast<std::size_t>(mesh_.n_owned_cells);
+    std::vector<double> stress(n_cells * 9), von_mises_stress(n_cells), volume_ratio(n_cells),
+        body_index(n_cells);
+    for (int c = 0; c < mesh_.n_owned_cells; ++c) {
+      const MatrixD<Dim> F =
+          deformation_gradient<Dim>(geometry<Dim>(c).gradients, nodal<Dim>(values, c));
+      const Matrix3 sigma = cauchy_stress<Dim>(body(c).material, F, body(c).fibres);
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          stress[static_cast<std::size_t>(c) * 9 + 3 * i + j] = sigma(i, j);
+      von_mises_stress[c] = von_mises(sigma);
+      volume_ratio[c] = F.determinant();
+      body_index[c] = body_of_cell_[c];
+    }
+    std::vector<io::Field> fields = {
+        {"displacement", Dim, io::Field::Location::vertex, values.values()},
+        {"cauchy_stress", 9, io::Field::Location::cell, stress},
+        {"von_mises_stress", 1, io::Field::Location::cell, von_mises_stress},
+        {"volume_ratio", 1, io::Field::Location::cell, volume_ratio},
+        {"body", 1, io::Field::Location::cell, body_index},
+    };
+    if (mass_)
+      fields.push_back({"velocity", Dim, io::Field::Location::vertex, velocities.values()});
+    fields.insert(fields.end(), extra.begin(), extra.end());
+    output.vtk("solid").write(mesh_, time, fields);
+  }
+
+  SolidParameters parameters_;
+  MPI_Comm comm_;
+  mesh::QualityReport quality_;
+  mesh::Mesh mesh_;
+  int dim_;
+  int rank_ = 0;
+  std::vector<int> body_of_cell_;
+  std::vector<PetscInt> dirichlet_dofs_;  ///< owned, sorted
+  std::vector<double> dirichlet_values_;  ///< final value of each, [m]
+  std::vector<ProbeLocation> probes_;
+
+  OwnedVec u_, v_, a_;                                ///< trial state
+  OwnedVec u_committed_, v_committed_, a_committed_;  ///< uₙ, vₙ, aₙ
+  OwnedVec external_;                                 ///< f_ext at load factor 1
+  OwnedVec residual_, inertia_;
+  fem::P1Matrix matrix_;
+  std::optional<fem::P1Matrix> mass_;  ///< inertia-density mass (dynamics only)
+  fem::LinearSolver solver_;
+  Vec extra_force_ = nullptr;   ///< not owned
+  NewtonHook* hook_ = nullptr;  ///< not owned
+  double density_offset_ = 0;
+};
+
+}  // namespace detail
+
+SolidModel::SolidModel(const config::Section& root, MPI_Comm comm)
+    : impl_(std::make_unique<detail::SolidModelImpl>(root, comm)) {}
+SolidModel::~SolidModel() = default;
+
+const mesh::Mesh& SolidModel::mesh() const {
+  return impl_->mesh();
+}
+int SolidModel::dim() const {
+  return impl_->dim();
+}
+MPI_Comm SolidModel::comm() const {
+  return impl_->comm();
+}
+const SolidParameters& SolidModel::parameters() const {
+  return impl_->parameters();
+}
+const mesh::QualityReport& SolidModel::quality() const {
+  return impl_->quality();
+}
+void SolidModel::describe() const {
+  impl_->describe();
+}
+const std::vector<int>& SolidModel::body_of_cell() const {
+  return impl_->body_of_cell();
+}
+const std::vector<PetscInt>& SolidModel::dirichlet_dofs() const {
+  return impl_->dirichlet_dofs();
+}
+Vec SolidModel::displacement() const {
+  return impl_->displacement();
+}
+Vec SolidModel::velocity() const {
+  return impl_->velocity();
+}
+Vec SolidModel::acceleration() const {
+  return impl_->acceleration();
+}
+void SolidModel::set_external_force(Vec force) {
+  impl_->set_external_force(force);
+}
+void SolidModel::set_hook(NewtonHook* hook) {
+  impl_->set_hook(hook);
+}
+void SolidModel::set_density_offset(double offset) {
+  impl_->set_density_offset(offset);
+}
+StepReport SolidModel::solve_static(double load_factor, run::RunOutput& output,
+                                    const std::string& label, bool verbose) {
+  return impl_->solve_static(load_factor, output, label, verbose);
+}
+void SolidModel::initialize_dynamics(run::RunOutput& output) {
+  impl_->initialize_dynamics(output);
+}
+StepReport SolidModel::step(double time, double time_step, run::RunOutput& output) {
+  return impl_->step(time, time_step, output);
+}
+void SolidModel::commit() {
+  impl_->commit();
+}
+void SolidModel::restore() {
+  impl_->restore();
+}
+std::vector<std::vector<double>> SolidModel::probe_values() const {
+  return impl_->probe_values();
+}
+double SolidModel::kinetic_energy() const {
+  return impl_->kinetic_energy();
+}
+double SolidModel::strain_energy() const {
+  return impl_->strain_energy();
+}
+double SolidModel::external_work() const {
+  return impl_->external_work();
+}
+double SolidModel::volume() const {
+  return impl_->volume();
+}
+std::vector<double> SolidModel::current_coordinates() const {
+  return impl_->current_coordinates();
+}
+void SolidModel::write_vtk(run::RunOutput& output, double time,
+                           const std::vector<io::Field>& extra) const {
+  impl_->write_vtk(output, time, extra);
+}
+
+}  // namespace coapt::solid

@@ -1,0 +1,165 @@
+#pragma once
+/// @file solid_model.hpp
+/// The solid as a reusable object: finite-strain P1 elasticity (total Lagrangian, plane strain
+/// in 2D) on one distributed mesh with one or more bodies, Dirichlet conditions, dead loads,
+/// probes, and two ways to advance it:
+///
+///  - quasi-static: solve_static(s) solves R(u) = f_int(u) − s f_ext − f_extra = 0 at load
+///    factor s (prescribed displacements ramped with s);
+///  - dynamic (Newmark β = 1/4, γ = 1/2, dynamics.hpp): initialize_dynamics() computes a₀, then
+///    step(t, Δt) solves M a(u) + f_int(u) − f_ext − f_extra = 0 for the *trial* state from the
+///    *committed* state (uₙ, vₙ, aₙ). step() may be repeated (coupling iterations: a new
+///    extra force, the same step) until commit() accepts the trial state; restore() returns the
+///    trial state to the committed one.
+///
+/// Two ways to act on the solid from outside:
+///  - set_external_force(f): an extra nodal force vector f_extra (a vertex vector of this
+///    mesh, node-major, dim components) in every residual, not ramped with the load factor
+///    (the transferred fluid force of the immersed coupling);
+///  - set_hook(h): a NewtonHook whose terms enter every Newton iteration (contact).
+///
+/// Immersed solids carry the density ρ_body − ρ_offset in their inertia (set_density_offset;
+/// the fluid mesh carries ρ_f over the overlap). Gravity keeps the full body density.
+///
+/// Every call is collective on comm(). Vectors are ghosted vertex vectors of mesh() with dim()
+/// components per vertex (fem::create_vertex_vector); the ghost entries of the state vectors
+/// are current after every call that changes them.
+///
+///   solid::SolidModel solid(root, comm);             // reads `problem: solid` case keys
+///   solid.initialize_dynamics(output);
+///   for (...) { solid.set_external_force(f); solid.step(t, dt, output); solid.commit(); }
+
+#include <mpi.h>
+#include <petscmat.h>
+#include <petscvec.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "coapt/core/config.hpp"
+#include "coapt/io/vtk_writer.hpp"
+#include "coapt/mesh/mesh.hpp"
+#include "coapt/mesh/quality.hpp"
+#include "coapt/run/run_output.hpp"
+#include "coapt/solid/solid_parameters.hpp"
+
+namespace coapt::solid {
+
+/// Extra terms in the solid's Newton iteration (e.g. contact). Every call is collective.
+class NewtonHook {
+ public:
+  virtual ~NewtonHook() = default;
+  /// Once per load or time step, before Newton starts from `u` (the predictor).
+  virtual void begin_step(Vec u) { (void)u; }
+  /// Adds the hook's terms to the residual R(u) (owned entries of `residual`; its Dirichlet
+  /// rows are zeroed afterwards).
+  virtual void add_residual(Vec u, Vec residual) {
+    (void)u;
+    (void)residual;
+  }
+  /// Called each Newton iteration with the assembled tangent K and rhs = −R (Dirichlet rows
+  /// and columns already eliminated): may change rhs and returns the matrix to solve with
+  /// (K itself, or a matrix the hook owns).
+  virtual Mat linear_system(Vec u, Mat K, Vec rhs) {
+    (void)u;
+    (void)rhs;
+    return K;
+  }
+  /// After each Newton update: false keeps Newton iterating even when the residual is below
+  /// tolerance (e.g. the active set changed).
+  virtual bool accept(Vec u) {
+    (void)u;
+    return true;
+  }
+};
+
+/// What one load step or time step did.
+struct StepReport {
+  int newton_iterations = 0;
+  int linear_iterations = 0;    ///< summed over the Newton iterations
+  std::vector<double> history;  ///< ‖R‖ over the free dofs, one per iterate
+  double norm() const { return history.empty() ? 0.0 : history.back(); }
+};
+
+namespace detail {
+class SolidModelImpl;
+}
+
+/// The solid: see the file comment.
+class SolidModel {
+ public:
+  /// Reads every key of a `problem: solid` case section (SolidParameters), loads and
+  /// distributes the mesh, assigns bodies, collects Dirichlet dofs and locates probes.
+  /// InputError naming the key, group or point on bad input.
+  SolidModel(const config::Section& root, MPI_Comm comm);
+  SolidModel(const SolidModel&) = delete;
+  SolidModel& operator=(const SolidModel&) = delete;
+  ~SolidModel();
+
+  const mesh::Mesh& mesh() const;
+  int dim() const;
+  MPI_Comm comm() const;
+  const SolidParameters& parameters() const;
+  const mesh::QualityReport& quality() const;
+  /// Logs sizes, bodies, the time scheme and Newton settings.
+  void describe() const;
+  /// Body index (into parameters().bodies) of each local cell.
+  const std::vector<int>& body_of_cell() const;
+  /// Owned global dofs with a prescribed displacement (ascending).
+  const std::vector<PetscInt>& dirichlet_dofs() const;
+
+  /// The trial state: displacement u, velocity v, acceleration a.
+  Vec displacement() const;
+  Vec velocity() const;
+  Vec acceleration() const;
+
+  /// An extra nodal force in every residual (null: none). The vector must live until it is
+  /// replaced; only its owned entries are read.
+  void set_external_force(Vec force);
+  /// The Newton hook (null: none). Not owned.
+  void set_hook(NewtonHook* hook);
+  /// Inertia uses the density ρ_body − offset [kg/m³] (≥ 0 for every body, else InputError).
+  /// Call before initialize_dynamics().
+  void set_density_offset(double offset);
+
+  /// One quasi-static load step at load factor s (0 < s ≤ 1). Throws ConvergenceError with
+  /// the residual history when Newton fails. `verbose` logs every Newton iteration.
+  StepReport solve_static(double load_factor, run::RunOutput& output, const std::string& label,
+                          bool verbose = true);
+
+  /// u₀ (Dirichlet values, else 0), v₀ (the case's initial velocity on free dofs), a₀ from
+  /// M a₀ = f_ext − f_int(u₀) (0 where there is no mass); commits that state.
+  void initialize_dynamics(run::RunOutput& output);
+  /// One Newmark step of size Δt from the committed state into the trial state (time = the
+  /// new time, for messages). Throws ConvergenceError with the history when Newton fails.
+  StepReport step(double time, double time_step, run::RunOutput& output);
+  /// The trial state becomes the committed state.
+  void commit();
+  /// The trial state is reset to the committed state.
+  void restore();
+
+  /// Displacement at each probe of the case (every rank gets every value).
+  std::vector<std::vector<double>> probe_values() const;
+  /// ½ vᵀ M v with the inertia density (0 before initialize_dynamics) [J, or J/m in 2D].
+  double kinetic_energy() const;
+  /// ∫ ψ(F) dX [J, or J/m in 2D].
+  double strain_energy() const;
+  /// f_extᵀ u at load factor 1 (the work of the dead loads).
+  double external_work() const;
+  /// Current volume ∫ det F dX [m³, or m² in 2D].
+  double volume() const;
+  /// The current coordinates X + u of the local vertices (owned and ghost), row-major.
+  std::vector<double> current_coordinates() const;
+
+  /// Displacement, velocity, Cauchy and von Mises stress, det F and body index into the
+  /// output's "solid" series at `time`, plus `extra` fields (vertex or owned-cell fields of
+  /// this mesh, e.g. a contact pressure).
+  void write_vtk(run::RunOutput& output, double time,
+                 const std::vector<io::Field>& extra = {}) const;
+
+ private:
+  std::unique_ptr<detail::SolidModelImpl> impl_;
+};
+
+}  // namespace coapt::solid

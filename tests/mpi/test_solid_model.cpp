@@ -1,0 +1,149 @@
+// SolidModel as the coupled problems use it, on 1, 2 and 3 ranks: the extra nodal force
+// enters the residual like a load, a Newmark step repeated from the committed state (a
+// coupling iteration) gives the same trial state, and a body whose inertia density is offset
+// to zero (an immersed solid as dense as the fluid) steps quasi-statically.
+
+#include <gtest/gtest.h>
+#include <petscvec.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+#include "coapt/core/context.hpp"
+#include "coapt/core/error.hpp"
+#include "coapt/fem/assembly.hpp"
+#include "coapt/mesh/mesh.hpp"
+#include "coapt/run/run_output.hpp"
+#include "coapt/solid/solid_model.hpp"
+
+namespace {
+
+using coapt::OwnedVec;
+using coapt::config::Document;
+using coapt::solid::SolidModel;
+
+const MPI_Comm kWorld = MPI_COMM_WORLD;
+
+/// A clamped strip [0, 1] × [0, 0.1] of linear elastic material, static or Newmark.
+std::string strip_case(const std::string& extra) {
+  return R"(problem: solid
+mesh: {type: rectangle, lower: [0, 0], upper: [1, 0.1], cells: [10, 2]}
+bodies:
+  - name: strip
+    density: 1000
+    material: {model: linear_elastic, young_modulus: 1.0e6, poisson_ratio: 0.3}
+dirichlet:
+  - boundary: left
+newton: {relative_tolerance: 1.0e-12}
+output: {vtk: false}
+)" + extra;
+}
+
+/// A run folder for the model's timers (one per test, removed afterwards).
+struct Output {
+  explicit Output(const std::string& name)
+      : directory(std::filesystem::temp_directory_path() / ("coapt_test_solid_model_" + name)),
+        output(kWorld, directory, "", "test", "test") {}
+  ~Output() {
+    int rank = 0;
+    MPI_Comm_rank(kWorld, &rank);
+    MPI_Barrier(kWorld);
+    if (rank == 0) std::filesystem::remove_all(directory);
+  }
+  std::filesystem::path directory;
+  coapt::run::RunOutput output;
+};
+
+double max_difference(Vec a, Vec b) {
+  Vec difference = nullptr;
+  VecDuplicate(a, &difference);
+  VecWAXPY(difference, -1.0, a, b);
+  PetscReal norm = 0;
+  VecNorm(difference, NORM_INFINITY, &norm);
+  VecDestroy(&difference);
+  return norm;
+}
+
+double max_norm(Vec a) {
+  PetscReal norm = 0;
+  VecNorm(a, NORM_INFINITY, &norm);
+  return norm;
+}
+
+TEST(SolidModel, ExtraForceActsLikeTheLoadItStandsFor) {
+  Output output("extra_force");
+  auto loaded = Document::from_string(strip_case("gravity: [0, -0.5]\n"), "loaded.yaml");
+  SolidModel reference(loaded.root(), kWorld);
+  reference.solve_static(1.0, output.output, "gravity", false);
+
+  auto unloaded = Document::from_string(strip_case(""), "unloaded.yaml");
+  SolidModel solid(unloaded.root(), kWorld);
+  const auto& mesh = solid.mesh();
+  // The nodal loads of gravity, ρ g |T|/3 per vertex of each cell, as an external force.
+  OwnedVec force = coapt::fem::create_vertex_vector(mesh, 2);
+  coapt::fem::assemble_vector(mesh, 2, force, [&](int c, double* element) {
+    const double share = 1000 * 0.5 * std::abs(coapt::mesh::cell_signed_measure(mesh, c)) / 3;
+    for (int a = 0; a < 3; ++a) {
+      element[2 * a] = 0.0;
+      element[2 * a + 1] = -share;
+    }
+  });
+  solid.set_external_force(force);
+  solid.solve_static(1.0, output.output, "extra force", false);
+  const double scale = max_norm(reference.displacement());
+  EXPECT_GT(scale, 1e-4);
+  EXPECT_LT(max_difference(reference.displacement(), solid.displacement()), 1e-10 * scale);
+}
+
+TEST(SolidModel, RepeatedStepFromTheCommittedStateIsIdentical) {
+  Output output("repeat");
+  auto document = Document::from_string(
+      strip_case("time: {scheme: newmark, step: 0.01, end_time: 1, initial_velocity: [0, 0.05]}\n"),
+      "dynamic.yaml");
+  SolidModel solid(document.root(), kWorld);
+  solid.initialize_dynamics(output.output);
+  solid.step(0.01, 0.01, output.output);
+  OwnedVec first = coapt::fem::create_vertex_vector(solid.mesh(), 2);
+  VecCopy(solid.displacement(), first);
+  EXPECT_GT(max_norm(first), 1e-5);
+
+  // A coupling iteration: another force, then back to none; the step is taken again.
+  OwnedVec force = coapt::fem::create_vertex_vector(solid.mesh(), 2);
+  VecSet(force, 1e-3);
+  solid.set_external_force(force);
+  solid.restore();
+  solid.step(0.01, 0.01, output.output);
+  EXPECT_GT(max_difference(first, solid.displacement()), 1e-8);
+  solid.set_external_force(nullptr);
+  solid.restore();
+  solid.step(0.01, 0.01, output.output);
+  EXPECT_EQ(max_difference(first, solid.displacement()), 0.0);
+
+  // After commit() the next step starts from the new state.
+  solid.commit();
+  solid.step(0.02, 0.01, output.output);
+  EXPECT_GT(max_difference(first, solid.displacement()), 1e-6);
+}
+
+TEST(SolidModel, ZeroInertiaDensityStepsQuasiStatically) {
+  Output output("offset");
+  auto dynamic = Document::from_string(
+      strip_case("gravity: [0, -0.5]\ntime: {scheme: newmark, step: 0.01, end_time: 1}\n"),
+      "dynamic.yaml");
+  SolidModel solid(dynamic.root(), kWorld);
+  solid.set_density_offset(1000);
+  solid.initialize_dynamics(output.output);
+  solid.step(0.01, 0.01, output.output);
+  EXPECT_EQ(solid.kinetic_energy(), 0.0);
+
+  auto quasi_static = Document::from_string(strip_case("gravity: [0, -0.5]\n"), "static.yaml");
+  SolidModel reference(quasi_static.root(), kWorld);
+  reference.solve_static(1.0, output.output, "static", false);
+  const double scale = max_norm(reference.displacement());
+  EXPECT_LT(max_difference(reference.displacement(), solid.displacement()), 1e-10 * scale);
+
+  EXPECT_THROW(solid.set_density_offset(1001), coapt::InputError);
+}
+
+}  // namespace
