@@ -1,6 +1,7 @@
 // coapt — fluid–structure–contact interaction by an immersed domain method.
 //
-//   coapt run CASE.yaml [--output DIR] [--set key.path=value ...] [-- PETSc options]
+//   coapt run CASE.yaml [--output DIR] [--restart DIR] [--set key.path=value ...]
+//       [-- PETSc options]
 //   coapt check CASE.yaml [--set key.path=value ...]
 //   coapt mesh FILE.msh
 //   coapt keys CASE.yaml        (the keys the case understands, with units and defaults)
@@ -34,6 +35,7 @@ constexpr int kExitInternal = 3;
 struct Options {
   std::string case_file;
   std::string output;
+  std::string restart;
   std::vector<std::string> overrides;
   std::string mesh_file;
   bool strict_options = false;
@@ -127,10 +129,18 @@ int run(const Options& options, const coapt::Context& context, const std::string
     auto document = load_case(options);
     auto problem = coapt::run::create_problem(document.root(), context.comm());
     document.reject_unknown_keys();
+    std::unique_ptr<coapt::run::CheckpointReader> checkpoint;
+    if (!options.restart.empty())
+      checkpoint = std::make_unique<coapt::run::CheckpointReader>(context.comm(), options.restart);
     output = std::make_unique<coapt::run::RunOutput>(
         context.comm(), directory, document.resolved_yaml(), options.case_file, command);
     coapt::log::info("coapt {} on {} rank(s): {} -> {}", COAPT_VERSION, context.size(),
                      options.case_file, directory);
+    if (checkpoint) {
+      coapt::log::info("restarting from {}", checkpoint->directory().string());
+      output->summary()["restarted_from"] = checkpoint->directory().string();
+      problem->restart_from(*checkpoint);
+    }
     problem->run(*output);
     const auto unused = coapt::Context::unused_petsc_options();
     if (!unused.empty()) {
@@ -179,6 +189,9 @@ int main(int argc, char** argv) {
                           "output folder (default: out/<case folder>-<case name>)");
   run_command->add_option("--set", options.overrides,
                           "override a key of the case: key.path=value (repeatable)");
+  run_command->add_option("--restart", options.restart,
+                          "continue from the last checkpoint of an earlier run folder DIR "
+                          "(the case's output.checkpoint_interval writes them)");
   run_command->add_flag("--strict-options", options.strict_options,
                         "fail when a PETSc option is never used");
   auto* check_command =

@@ -4,6 +4,7 @@
 /// meshes when created (so `coapt check` validates a case without solving), describes
 /// itself, and runs into a RunOutput.
 
+#include <fmt/format.h>
 #include <mpi.h>
 
 #include <functional>
@@ -12,6 +13,8 @@
 #include <vector>
 
 #include "coapt/core/config.hpp"
+#include "coapt/core/error.hpp"
+#include "coapt/run/checkpoint.hpp"
 #include "coapt/run/run_output.hpp"
 
 namespace coapt::run {
@@ -25,6 +28,12 @@ class Problem {
   /// Runs to the end, writing into `output` (series, VTK, summary["benchmark"]).
   /// Throws coapt::Error on failure; the caller marks the run failed.
   virtual void run(RunOutput& output) = 0;
+  /// Continues from the checkpoint of an earlier run (`coapt run CASE --restart DIR`); called
+  /// after creation, before run(). Problems that write no checkpoints refuse.
+  virtual void restart_from(const CheckpointReader& checkpoint) {
+    throw InputError(fmt::format("--restart {}: this problem kind writes no checkpoints",
+                                 checkpoint.directory().string()));
+  }
 };
 
 /// A registered problem kind.

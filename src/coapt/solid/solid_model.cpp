@@ -302,6 +302,19 @@ class SolidModelImpl {
     fem::update_ghosts(a_);
   }
 
+  void write_checkpoint(run::CheckpointWriter& writer, const std::string& prefix) const {
+    writer.add_vertex_field(prefix + "u", mesh_, u_committed_, dim_);
+    writer.add_vertex_field(prefix + "v", mesh_, v_committed_, dim_);
+    writer.add_vertex_field(prefix + "a", mesh_, a_committed_, dim_);
+  }
+
+  void read_checkpoint(const run::CheckpointReader& reader, const std::string& prefix) {
+    reader.read_vertex_field(prefix + "u", mesh_, u_committed_, dim_);
+    reader.read_vertex_field(prefix + "v", mesh_, v_committed_, dim_);
+    reader.read_vertex_field(prefix + "a", mesh_, a_committed_, dim_);
+    restore();
+  }
+
   // --- reported quantities --------------------------------------------------------------------
 
   std::vector<std::vector<double>> probe_values() const {
@@ -874,6 +887,12 @@ void SolidModel::commit() {
 }
 void SolidModel::restore() {
   impl_->restore();
+}
+void SolidModel::write_checkpoint(run::CheckpointWriter& writer, const std::string& prefix) const {
+  impl_->write_checkpoint(writer, prefix);
+}
+void SolidModel::read_checkpoint(const run::CheckpointReader& reader, const std::string& prefix) {
+  impl_->read_checkpoint(reader, prefix);
 }
 std::vector<std::vector<double>> SolidModel::probe_values() const {
   return impl_->probe_values();

@@ -41,6 +41,7 @@
 #include "coapt/io/vtk_writer.hpp"
 #include "coapt/mesh/mesh.hpp"
 #include "coapt/mesh/quality.hpp"
+#include "coapt/run/checkpoint.hpp"
 #include "coapt/run/run_output.hpp"
 #include "coapt/solid/solid_parameters.hpp"
 
@@ -138,6 +139,11 @@ class SolidModel {
   void commit();
   /// The trial state is reset to the committed state.
   void restore();
+
+  /// Adds the committed state (fields `prefix`u, `prefix`v, `prefix`a) to a checkpoint.
+  void write_checkpoint(run::CheckpointWriter& writer, const std::string& prefix = "solid_") const;
+  /// Reads the committed state back (after initialize_dynamics()); the trial state equals it.
+  void read_checkpoint(const run::CheckpointReader& reader, const std::string& prefix = "solid_");
 
   /// Displacement at each probe of the case (every rank gets every value).
   std::vector<std::vector<double>> probe_values() const;

@@ -220,6 +220,10 @@ SolidParameters SolidParameters::read(const config::Section& root) {
   p.vtk_interval = output.get<int>(
       "vtk_interval", 1,
       {"", "time steps between VTK files (newmark scheme)", Bounds::closed(1, 1000000)});
+  p.checkpoint_interval =
+      output.get<int>("checkpoint_interval", 0,
+                      {"", "time steps between checkpoints for --restart (newmark scheme; 0: none)",
+                       Bounds::closed(0, 1000000)});
   return p;
 }
 

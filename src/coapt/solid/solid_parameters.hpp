@@ -21,7 +21,8 @@
 ///                                      dynamics (dynamics.hpp); scheme: static (default)
 ///   newton: {relative_tolerance, absolute_tolerance, update_tolerance, max_iterations}
 ///   probes: [{name: tip, point: [0.048, 0.060]}]
-///   output: {vtk: true, vtk_interval: 10}   (vtk_interval: time steps between VTK files)
+///   output: {vtk: true, vtk_interval: 10, checkpoint_interval: 100}
+///                                      (time steps between VTK files / checkpoints)
 
 #include <string>
 #include <vector>
@@ -99,7 +100,8 @@ struct SolidParameters {
   TimeParameters time;
   std::vector<ProbeParameters> probes;
   bool write_vtk = true;
-  int vtk_interval = 1;  ///< dynamics: VTK every this many time steps
+  int vtk_interval = 1;         ///< dynamics: VTK every this many time steps
+  int checkpoint_interval = 0;  ///< dynamics: a checkpoint every this many steps (0: none)
 
   /// Reads and checks every key (InputError located at the key). Vector lengths are checked
   /// against the mesh dimension later (check_dimension).

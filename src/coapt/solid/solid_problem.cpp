@@ -10,6 +10,7 @@
 
 #include "coapt/core/log.hpp"
 #include "coapt/core/progress.hpp"
+#include "coapt/core/timer.hpp"
 #include "coapt/io/json.hpp"
 #include "coapt/solid/dynamics.hpp"
 #include "coapt/solid/solid_model.hpp"
@@ -24,6 +25,16 @@ class SolidProblem final : public run::Problem {
   SolidProblem(const config::Section& root, MPI_Comm comm) : solid_(root, comm) {}
 
   void describe() const override { solid_.describe(); }
+
+  /// Newmark runs continue from a checkpoint of an earlier run (written every
+  /// output.checkpoint_interval steps): the committed state, the step, and what the summary
+  /// needs (energy bookkeeping, probe histories). The reader must live until run() returns.
+  void restart_from(const run::CheckpointReader& checkpoint) override {
+    if (!parameters().time.dynamic)
+      throw InputError(fmt::format("--restart {}: a quasi-static solid run has no checkpoints",
+                                   checkpoint.directory().string()));
+    restart_ = &checkpoint;
+  }
 
   void run(run::RunOutput& output) override {
     describe();
@@ -115,12 +126,52 @@ class SolidProblem final : public run::Problem {
       series.add("newton_iterations", iterations);
       series.end_row();
     };
-    record(0, 0.0, 0);
-    if (parameters().write_vtk) solid_.write_vtk(output, 0.0);
+    int first_step = 1;
+    if (restart_) {
+      solid_.read_checkpoint(*restart_);
+      const auto& state = restart_->state();
+      const auto doubles = [](const io::Json& array) {
+        std::vector<double> values;
+        for (const auto& value : array.as_array()) values.push_back(value.as_double());
+        return values;
+      };
+      first_step = static_cast<int>(state.at("step").as_int()) + 1;
+      initial_energy = state.at("initial_energy").as_double();
+      energy_scale = state.at("energy_scale").as_double();
+      largest_change = state.at("largest_energy_change").as_double();
+      times = doubles(state.at("times"));
+      const auto& histories = state.at("probe_history");
+      if (histories.size() != probe_history.size())
+        throw InputError(
+            fmt::format("--restart {}: the checkpoint has {} probe histories, the "
+                        "case {}",
+                        restart_->directory().string(), histories.size(), probe_history.size()));
+      for (std::size_t k = 0; k < probe_history.size(); ++k)
+        probe_history[k] = doubles(histories.at(k));
+      log::info("continuing after step {} (t = {:g} s)", first_step - 1, times.back());
+    } else {
+      record(0, 0.0, 0);
+      if (parameters().write_vtk) solid_.write_vtk(output, 0.0);
+    }
+    const auto checkpoint = [&](int step, double t) {
+      ScopedTimer timer(output.timers(), "checkpoint");
+      run::CheckpointWriter writer(solid_.comm(), output.directory() / "checkpoint");
+      auto& state = writer.state();
+      state["step"] = step;
+      state["time"] = t;
+      state["initial_energy"] = initial_energy;
+      state["energy_scale"] = energy_scale;
+      state["largest_energy_change"] = largest_change;
+      state["times"] = io::Json::array_of(times);
+      auto& histories = state["probe_history"] = io::Json::array();
+      for (const auto& history : probe_history) histories.push_back(io::Json::array_of(history));
+      solid_.write_checkpoint(writer);
+      writer.commit();
+    };
 
     int total_newton = 0, total_linear = 0;
     Progress progress(time.n_steps, time.end_time);
-    for (int step = 1; step <= time.n_steps; ++step) {
+    for (int step = first_step; step <= time.n_steps; ++step) {
       const double t = step * time.step;
       const auto report = solid_.step(t, time.step, output);
       solid_.commit();
@@ -133,6 +184,8 @@ class SolidProblem final : public run::Problem {
                       report.history.front(), report.norm(), report.linear_iterations));
       if (parameters().write_vtk && step % parameters().vtk_interval == 0)
         solid_.write_vtk(output, t);
+      if (parameters().checkpoint_interval > 0 && step % parameters().checkpoint_interval == 0)
+        checkpoint(step, t);
     }
 
     auto& benchmark = output.summary()["benchmark"];
@@ -168,6 +221,7 @@ class SolidProblem final : public run::Problem {
   }
 
   SolidModel solid_;
+  const run::CheckpointReader* restart_ = nullptr;
 };
 
 }  // namespace

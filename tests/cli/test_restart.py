@@ -1,0 +1,86 @@
+#!/usr/bin/python3
+"""Checkpoint and restart (`coapt run CASE --restart DIR`, src/coapt/run/checkpoint.hpp), on the
+Newmark free vibration (cases/solid/vibration.yaml, 40 steps):
+
+- a run of 20 steps writing a checkpoint at step 20, restarted to step 40 on the same 2 ranks,
+  gives steps 21..40 of series.csv and the summary's benchmark bit for bit as the run of 40
+  steps straight through;
+- restarted on 1 and 3 ranks (another partition), the same to 1e-9 relative (solver tolerance);
+- a missing checkpoint folder, a checkpoint of another mesh and a quasi-static case are refused
+  with one error line naming the folder, exit 2."""
+
+import csv
+
+from cli_common import Runner, parse_arguments, read_json
+
+CASE = "solid/vibration.yaml"
+
+
+def rows(path):
+    with open(path) as f:
+        return list(csv.DictReader(f))
+
+
+def main():
+    arguments = parse_arguments()
+    runner = Runner(arguments)
+    work = runner.work
+    case = runner.source / "cases" / CASE
+    every = ["--set", "output.checkpoint_interval=20"]
+
+    def run(output, end_time, *extra, ranks=2):
+        return runner.run("run", case, "--output", work / output, "--set",
+                          f"time.end_time={end_time}", *every, *extra, ranks=ranks)
+
+    straight = run("straight", 0.4)
+    first = run("first", 0.2)
+    again = run("again", 0.4, "--restart", work / "first")
+    for name, result in [("straight", straight), ("first", first), ("restarted", again)]:
+        runner.expect(result.returncode == 0, f"{name} run succeeds", result.stdout + result.stderr)
+    if runner.failures:
+        runner.finish()
+    runner.expect((work / "first" / "checkpoint" / "state.json").exists(),
+                  "the first run wrote a checkpoint")
+    reference = {row["step"]: row for row in rows(work / "straight" / "series.csv")}
+    restarted = rows(work / "again" / "series.csv")
+    runner.expect([row["step"] for row in restarted] == [str(k) for k in range(21, 41)],
+                  "the restarted series holds steps 21..40",
+                  str([row["step"] for row in restarted]))
+    identical = all(row == reference[row["step"]] for row in restarted)
+    runner.expect(identical, "same ranks: steps 21..40 bit for bit as the straight run")
+    benchmark = read_json(work / "straight" / "summary.json")["benchmark"]
+    restarted_benchmark = read_json(work / "again" / "summary.json")["benchmark"]
+    runner.expect(benchmark == restarted_benchmark, "same ranks: the benchmark bit for bit",
+                  f"{benchmark}\n{restarted_benchmark}")
+
+    for ranks in (1, 3):
+        result = run(f"again{ranks}", 0.4, "--restart", work / "first", ranks=ranks)
+        runner.expect(result.returncode == 0, f"restart on {ranks} rank(s) succeeds",
+                      result.stdout + result.stderr)
+        if result.returncode != 0:
+            continue
+        last = rows(work / f"again{ranks}" / "series.csv")[-1]
+        worst = 0.0
+        for key in ("tip_displacement_y", "kinetic_energy", "total_energy"):
+            a, b = float(last[key]), float(reference["40"][key])
+            worst = max(worst, abs(a - b) / abs(b))
+        runner.expect(worst < 1e-9, f"restart on {ranks} rank(s): step 40 agrees to 1e-9",
+                      f"largest relative difference {worst:.3e}")
+
+    def refused(result, what, needle):
+        errors = [line for line in result.stderr.splitlines() if "error:" in line]
+        runner.expect(result.returncode == 2 and len(errors) == 1 and needle in errors[0],
+                      f"refused: {what}", result.stdout + result.stderr)
+
+    refused(run("bad1", 0.4, "--restart", work / "nowhere"), "a folder without a checkpoint",
+            "nowhere")
+    refused(run("bad2", 0.4, "--restart", work / "first", "--set", "mesh.cells=[12, 2]"),
+            "a checkpoint of another mesh", "checkpoint")
+    refused(runner.run("run", runner.source / "cases" / "cook" / "linear.yaml", "--output",
+                       work / "bad3", "--restart", work / "first", ranks=1),
+            "a quasi-static case", "first")
+    runner.finish()
+
+
+if __name__ == "__main__":
+    main()
