@@ -30,4 +30,21 @@ struct TransferBenchOptions {
 /// after a small motion of the master. Collective.
 io::Json transfer(const Context& context, const TransferBenchOptions& options);
 
+struct FluidBenchOptions {
+  int n = 8;
+  int repeat = 3;
+};
+/// `coapt-bench fluid`: residual and Jacobian assembly of the stabilised Navier–Stokes operator
+/// and one steady Newton solve on a 3D box channel (bench_fluid.cpp). Collective.
+io::Json fluid(const Context& context, const FluidBenchOptions& options);
+
+struct SolidBenchOptions {
+  int n = 44;
+  std::string formulation = "displacement";  ///< or "mixed"
+};
+/// `coapt-bench solid`: Newton iterations of the nearly incompressible Neo-Hookean solid on the
+/// unit cube (n³ · 6 tets): time per iteration, assembly and solve (bench_solid.cpp).
+/// Collective.
+io::Json solid(const Context& context, const SolidBenchOptions& options);
+
 }  // namespace coapt::bench

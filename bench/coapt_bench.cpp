@@ -1,6 +1,8 @@
 // coapt-bench: coapt's benchmark program, one sub-command per measurement.
 //
 //   mpirun -np 2 coapt-bench assembly --n 64
+//   mpirun -np 2 coapt-bench fluid --n 12 -- -fluid_pc_type lu
+//   mpirun -np 2 coapt-bench solid --n 44
 //
 // Each sub-command prints what it does and ends with one line holding a JSON object of the
 // figures (rates carry their unit in the key) and the peak memory per rank (peak_rss_mb).
@@ -35,6 +37,22 @@ int main(int argc, char** argv) {
   transfer_command->add_option("--n", transfer.n, "cells per direction")->check(CLI::Range(1, 400));
   transfer_command->add_option("--case", transfer.case_name, "jitter or rotated")
       ->check(CLI::IsMember({"jitter", "rotated"}));
+  coapt::bench::FluidBenchOptions fluid;
+  auto* fluid_command = app.add_subcommand(
+      "fluid",
+      "stabilised Navier-Stokes on a 3D channel (4n x n x n cubes * 6 tets): assembly, one "
+      "steady Newton solve");
+  fluid_command->add_option("--n", fluid.n, "cells across the channel")->check(CLI::Range(1, 200));
+  fluid_command->add_option("--repeat", fluid.repeat, "assemblies timed (the mean is reported)")
+      ->check(CLI::Range(1, 1000));
+  coapt::bench::SolidBenchOptions solid;
+  auto* solid_command = app.add_subcommand(
+      "solid",
+      "nearly incompressible Neo-Hookean solid on the unit cube (n^3 * 6 tets): time per Newton "
+      "iteration, assembly and solve");
+  solid_command->add_option("--n", solid.n, "cells per direction")->check(CLI::Range(1, 200));
+  solid_command->add_option("--formulation", solid.formulation, "displacement or mixed")
+      ->check(CLI::IsMember({"displacement", "mixed"}));
   try {
     app.parse(n_ours, argv);
   } catch (const CLI::ParseError& e) {
@@ -46,6 +64,8 @@ int main(int argc, char** argv) {
     coapt::io::Json figures;
     if (*assembly_command) figures = coapt::bench::assembly(context, assembly);
     if (*transfer_command) figures = coapt::bench::transfer(context, transfer);
+    if (*fluid_command) figures = coapt::bench::fluid(context, fluid);
+    if (*solid_command) figures = coapt::bench::solid(context, solid);
     figures["peak_rss_mb"] = coapt::bench::peak_rss_mb(context.comm());
     if (context.rank() == 0) std::cout << figures.dump(-1) << std::endl;
   } catch (const coapt::Error& e) {

@@ -15,8 +15,13 @@
 ///   R_q = ∫_T q ∇·u + (τ_M/ρ) ∇q·r_M                            (Galerkin + PSPG)
 ///
 /// The Laplace form μ∇w:∇u makes the natural condition μ ∂_n u − p n = 0: the DFG
-/// "do-nothing" outflow (Schäfer & Turek 1996). With τ_M [s] and τ_C [m²/s] every term of R_w
-/// has the unit of ρ a·w and every term of R_q that of q/s.
+/// "do-nothing" outflow (Schäfer & Turek 1996). The symmetric (stress) form replaces it by
+/// 2μ ∇w:ε(u) = μ ∇w:(∇u + ∇uᵀ), whose natural condition is the traction σ(u, p) n = 0 with
+/// σ = −p I + 2μ ε(u), the one traction outlets and fluid–structure forces need. The two agree
+/// for divergence-free u with Dirichlet data (∫ ∇w:∇uᵀ = ∫ (∇·w)(∇·u) after integration by
+/// parts), so they differ only through the natural boundary condition and the discrete ∇·u_h. With
+/// τ_M [s] and τ_C [m²/s] every term of R_w has the unit of ρ a·w and every term of R_q that of
+/// q/s.
 ///
 /// Stabilisation parameters (Bazilevs et al. 2007, element metric form):
 ///   τ_M = ((2/Δt)² + u·G·u + C_I ν² G:G)^(−1/2),  τ_C = 1/(τ_M tr G),  ν = μ/ρ,
@@ -92,6 +97,9 @@ inline double value_of(const Dual<N>& a) {
   return a.v;
 }
 
+/// Form of the viscous term: Laplace μ∇w:∇u, or symmetric (stress) 2μ∇w:ε(u).
+enum class ViscousForm { laplace, stress };
+
 /// Everything an element residual needs besides the unknowns; all doubles (frozen in Newton).
 template <int Dim>
 struct ElementData {
@@ -102,8 +110,9 @@ struct ElementData {
   double mass_coefficient = 0;     ///< α₀/Δt [1/s] (0: steady)
   double history[Dim + 1][Dim]{};  ///< known part of u̇ at each vertex [m/s²]
   bool convection = true;          ///< false: Stokes (u·∇u dropped, also from τ)
-  double tau_m = 0;                ///< τ_M [s]
-  double tau_c = 0;                ///< τ_C [m²/s]
+  ViscousForm viscous_form = ViscousForm::laplace;  ///< the viscous term (file comment)
+  double tau_m = 0;                                 ///< τ_M [s]
+  double tau_c = 0;                                 ///< τ_C [m²/s]
 };
 
 /// BDF weights (α₀, α₁, α₂) with u̇ⁿ⁺¹ ≈ (α₀uⁿ⁺¹ + α₁uⁿ + α₂uⁿ⁻¹)/Δtₙ for ω = Δtₙ/Δtₙ₋₁:
@@ -185,10 +194,14 @@ inline void element_residual(const ElementData<Dim>& e, const S* x, S* r) {
   for (int i = 0; i < Dim; ++i) div += grad_u[i][i];
   const double rho = e.density, mu = e.viscosity;
   // Terms with constant integrands: viscous, LSIC, continuity's Galerkin part uses the mean.
+  const bool stress = e.viscous_form == ViscousForm::stress;
   for (int a = 0; a < n; ++a)
     for (int i = 0; i < Dim; ++i) {
       S viscous(0.0);
-      for (int j = 0; j < Dim; ++j) viscous += g[a][j] * grad_u[i][j];
+      for (int j = 0; j < Dim; ++j) {
+        viscous += g[a][j] * grad_u[i][j];
+        if (stress) viscous += g[a][j] * grad_u[j][i];  // ∇w:∇uᵀ
+      }
       r[a * n + i] += (e.measure * mu) * viscous + (e.measure * rho * e.tau_c * g[a][i]) * div;
     }
   using Rule = Degree2Rule<Dim>;

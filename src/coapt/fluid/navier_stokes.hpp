@@ -21,18 +21,20 @@
 #include "coapt/core/petsc.hpp"
 #include "coapt/fem/assembly.hpp"
 #include "coapt/fem/linear_solver.hpp"
+#include "coapt/fluid/kernels.hpp"
 #include "coapt/mesh/mesh.hpp"
 
 namespace coapt::fluid {
 
 /// Material, stabilisation and Newton settings (read once by the driver).
 struct FluidParameters {
-  double density = 1.0;                      ///< ρ [kg/m³]
-  double viscosity = 1.0;                    ///< dynamic viscosity μ [Pa s]
-  bool convection = true;                    ///< false: Stokes
-  double c_inverse = 9.0;                    ///< C_I of τ_M (kernels.hpp)
-  double newton_relative_tolerance = 1e-8;   ///< ‖R‖ ≤ rtol ‖R₀‖ ...
-  double newton_absolute_tolerance = 1e-10;  ///< ... or ‖R‖ ≤ atol
+  double density = 1.0;                             ///< ρ [kg/m³]
+  double viscosity = 1.0;                           ///< dynamic viscosity μ [Pa s]
+  bool convection = true;                           ///< false: Stokes
+  ViscousForm viscous_form = ViscousForm::laplace;  ///< the viscous term (kernels.hpp)
+  double c_inverse = 9.0;                           ///< C_I of τ_M (kernels.hpp)
+  double newton_relative_tolerance = 1e-8;          ///< ‖R‖ ≤ rtol ‖R₀‖ ...
+  double newton_absolute_tolerance = 1e-10;         ///< ... or ‖R‖ ≤ atol
   int newton_max_iterations = 25;
 };
 
@@ -133,6 +135,15 @@ class NavierStokes {
   /// J and the Woodbury formula; returns the Krylov iterations of all solves.
   int solve_with_outlets(Vec rhs, Vec solution, const std::vector<PetscInt>& fixed);
 
+  /// The default preconditioner (navier_stokes.cpp, solver_defaults): with -fluid_pc_type
+  /// fieldsplit, velocity and pressure splits "u", "p" and a Schur complement factorisation
+  /// whose pressure preconditioner update_schur_preconditioner assembles, unless the options
+  /// choose another one.
+  void configure_preconditioner();
+  /// S_p = A_pp − A_pu diag(A_uu)⁻¹ A_up + c M_p/μ_eff for the current (row-fixed) Jacobian,
+  /// handed to the Schur split. Collective.
+  void update_schur_preconditioner(const TimeLevel& time);
+
   /// Per outlet: its settings and flux vector b.
   std::vector<Outlet> outlets_;
   std::vector<OwnedVec> outlet_flux_;
@@ -147,6 +158,10 @@ class NavierStokes {
   fem::LinearSolver solver_;
   std::vector<PetscInt> dirichlet_dofs_;
   std::vector<int> constrained_vertices_;
+  /// Owned velocity and pressure dofs (the splits) and the assembled Schur preconditioner.
+  OwnedIS velocity_dofs_, pressure_dofs_;
+  OwnedMat schur_preconditioner_;
+  bool user_schur_ = false;  ///< update_schur_preconditioner supplies S_p
 };
 
 }  // namespace coapt::fluid

@@ -1,8 +1,10 @@
 #include "coapt/run/problem.hpp"
 
+#include "coapt/coupling/fsci_problem.hpp"
 #include "coapt/fluid/flow_problem.hpp"
 #include "coapt/problems/manufactured.hpp"
 #include "coapt/solid/solid_problem.hpp"
+#include "coapt/transfer/transfer_problem.hpp"
 
 namespace coapt::run {
 
@@ -17,6 +19,11 @@ const std::vector<ProblemKind>& problem_kinds() {
        solid::create_solid_problem},
       {"navier_stokes", "incompressible Navier-Stokes, P1-P1 SUPG/PSPG/LSIC",
        fluid::create_flow_problem},
+      {"fsci", "immersed fluid-solid coupling: solids constrain the fluid over their overlap",
+       coupling::create_fsci_problem},
+      {"transfer",
+       "variational transfer of an analytic field between two meshes (errors, conservation)",
+       transfer::create_transfer_problem},
   };
   return kinds;
 }

@@ -14,6 +14,8 @@
 /// Pure functions, no MPI, no allocation.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
 #include <cmath>
 
 #include "coapt/fem/p1.hpp"
@@ -124,6 +126,73 @@ template <int Dim>
 inline Eigen::Matrix<double, Dim, 1> uniform_nodal_load(const Eigen::Matrix<double, Dim, 1>& f,
                                                         double measure, int n_vertices) {
   return f * (measure / n_vertices);
+}
+
+/// Current positions of the vertices of one boundary facet: row a = x_a (Dim vertices).
+template <int Dim>
+using FacetPositions = Eigen::Matrix<double, Dim, Dim>;
+/// Element vector of a facet (facet-vertex-major, Dim·Dim entries).
+template <int Dim>
+using FacetVector = Eigen::Matrix<double, Dim * Dim, 1>;
+/// Element matrix of a facet (facet-vertex-major, row-major).
+template <int Dim>
+using FacetMatrix = Eigen::Matrix<double, Dim * Dim, Dim * Dim, Eigen::RowMajor>;
+
+/// Follower pressure p [Pa] on a boundary facet in its current position: the load −p n da,
+/// so the residual (internal minus external forces) gets
+///
+///   r_a = p ∫ n N_a da = p N / Dim  per facet vertex a,
+///
+/// with N the area-weighted outward normal of the current facet (the facet's vertices are
+/// ordered with the normal out of its cell, Mesh::facets): in 3D N = ½ (x₁ − x₀) × (x₂ − x₀)
+/// (so r_a = p/6 (x₁ − x₀) × (x₂ − x₀)); in 2D (per unit thickness, the cell on the left of
+/// x₀ → x₁) N = Q (x₁ − x₀) with Q = [[0, 1], [−1, 0]].
+template <int Dim>
+inline FacetVector<Dim> pressure_facet_residual(const FacetPositions<Dim>& x, double pressure) {
+  Eigen::Matrix<double, Dim, 1> normal;  // p N / Dim, the force on each vertex
+  if constexpr (Dim == 2) {
+    const Eigen::Vector2d e = (x.row(1) - x.row(0)).transpose();
+    normal << e(1), -e(0);
+    normal *= 0.5 * pressure;  // p N / 2
+  } else {
+    const Eigen::Vector3d e1 = (x.row(1) - x.row(0)).transpose();
+    const Eigen::Vector3d e2 = (x.row(2) - x.row(0)).transpose();
+    normal = e1.cross(e2) * (pressure / 6.0);  // p (½ e₁ × e₂) / 3
+  }
+  FacetVector<Dim> r;
+  for (int a = 0; a < Dim; ++a) r.template segment<Dim>(a * Dim) = normal;
+  return r;
+}
+
+/// Its exact derivative ∂r_ai/∂x_bk (= ∂r_ai/∂u_bk): in 3D, with [v]× w = v × w,
+/// ∂N/∂x₀ = ½([e₂]× − [e₁]×), ∂N/∂x₁ = −½[e₂]×, ∂N/∂x₂ = ½[e₁]×, e₁ = x₁ − x₀, e₂ = x₂ − x₀;
+/// in 2D ∂N/∂x₀ = −Q, ∂N/∂x₁ = Q. Not symmetric: a follower load is not conservative facet
+/// by facet.
+template <int Dim>
+inline FacetMatrix<Dim> pressure_facet_tangent(const FacetPositions<Dim>& x, double pressure) {
+  FacetMatrix<Dim> K;
+  std::array<Eigen::Matrix<double, Dim, Dim>, Dim> derivative;  // ∂(r_a)/∂x_b, same for all a
+  if constexpr (Dim == 2) {
+    Eigen::Matrix2d Q;
+    Q << 0.0, 1.0, -1.0, 0.0;
+    derivative[0] = -0.5 * pressure * Q;
+    derivative[1] = 0.5 * pressure * Q;
+  } else {
+    const auto cross_matrix = [](const Eigen::Vector3d& v) {
+      Eigen::Matrix3d m;
+      m << 0.0, -v(2), v(1), v(2), 0.0, -v(0), -v(1), v(0), 0.0;
+      return m;
+    };
+    const Eigen::Matrix3d E1 = cross_matrix((x.row(1) - x.row(0)).transpose());
+    const Eigen::Matrix3d E2 = cross_matrix((x.row(2) - x.row(0)).transpose());
+    const double scale = pressure / 6.0;
+    derivative[0] = scale * (E2 - E1);
+    derivative[1] = -scale * E2;
+    derivative[2] = scale * E1;
+  }
+  for (int a = 0; a < Dim; ++a)
+    for (int b = 0; b < Dim; ++b) K.template block<Dim, Dim>(a * Dim, b * Dim) = derivative[b];
+  return K;
 }
 
 }  // namespace coapt::solid

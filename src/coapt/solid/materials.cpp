@@ -112,4 +112,45 @@ std::string_view name(const Material& material) {
   return std::visit(Names{}, material);
 }
 
+UniaxialState uniaxial_state(const FibreReinforced& law, const FibreDirections& fibres,
+                             const Vector3& axis, double stretch, std::string_view where) {
+  if (!(stretch > 0.0) || !std::isfinite(stretch))
+    throw InputError(fmt::format("{}: stretch {} must be positive", where, stretch));
+  const Vector3 e = axis.normalized();
+  const double mu = law.shear_modulus, kappa = law.bulk_modulus, l2 = stretch * stretch;
+  double fibre_stress_factor = 0;  // Σ over families along e of 2 ψ'(λ²) λ²
+  for (int f = 0; f < law.n_fibre_families; ++f) {
+    const double cosine = std::abs(fibres.a0[f].normalized().dot(e));
+    if (std::abs(cosine - 1.0) < 1e-12) {
+      const double strain = l2 - 1.0;
+      if (strain > 0.0)
+        fibre_stress_factor +=
+            2.0 * law.fibre_k1 * strain * std::exp(law.fibre_k2 * strain * strain) * l2;
+    } else if (cosine < 1e-12) {
+      if (stretch < 1.0)
+        throw InputError(fmt::format(
+            "{}: fibre family {} across the axis would be stretched by the lateral expansion "
+            "(stretch {} < 1): not a uniaxial state of closed form",
+            where, f + 1, stretch));
+    } else {
+      throw InputError(fmt::format(
+          "{}: fibre family {} is neither along nor across the stretch axis", where, f + 1));
+    }
+  }
+  const auto lateral_stress = [&](double t) {
+    const double J = stretch * t * t;
+    return -mu / 3.0 * std::pow(J, -5.0 / 3.0) * (l2 - t * t) + 0.5 * kappa * (J - 1.0 / J);
+  };
+  // σ_⊥ increases with t from −∞ (J → 0); bracket its root and bisect to round-off.
+  double low = 1e-3 / std::sqrt(stretch), high = 1.0 / std::sqrt(stretch);
+  while (lateral_stress(low) > 0.0) low *= 0.5;
+  while (lateral_stress(high) < 0.0) high *= 2.0;
+  for (int iteration = 0; iteration < 200 && high - low > 1e-16 * high; ++iteration) {
+    const double middle = 0.5 * (low + high);
+    (lateral_stress(middle) < 0.0 ? low : high) = middle;
+  }
+  const double t = 0.5 * (low + high), J = stretch * t * t;
+  return {mu * std::pow(J, -5.0 / 3.0) * (l2 - t * t) + fibre_stress_factor / J, t};
+}
+
 }  // namespace coapt::solid

@@ -92,6 +92,23 @@ void validate_fibres(const Material& material, const FibreDirections& fibres,
 /// "neo_hookean", "nearly_incompressible_neo_hookean", "fibre_reinforced".
 std::string_view name(const Material& material);
 
+/// Homogeneous uniaxial Cauchy stress of the fibre-reinforced law (closed form): the body is
+/// stretched by λ along the unit `axis` with free lateral faces, F = λ e⊗e + t (I − e⊗e).
+/// The lateral stretch t solves the closed-form lateral stress
+///   σ_⊥ = −μ/3 J^{−5/3} (λ² − t²) + κ (J − 1/J)/2 = 0,  J = λ t²,
+/// (by bisection), and then
+///   σ_∥ = μ J^{−5/3} (λ² − t²) + Σ_{f along e} 2 ψ_f'(λ²) λ²/J,
+/// ψ_f'(I₄) = k₁ (I₄ − 1) exp(k₂ (I₄ − 1)²) for I₄ > 1, else 0. Every fibre family must lie
+/// along the axis or across it; a family across it must stay slack (λ ≥ 1, so t ≤ 1), which
+/// keeps the state transversely isotropic. InputError (naming `where`) otherwise.
+struct UniaxialState {
+  double stress = 0;           ///< σ_∥ [Pa]
+  double lateral_stretch = 1;  ///< t [-]
+};
+UniaxialState uniaxial_state(const FibreReinforced& law, const FibreDirections& fibres,
+                             const Vector3& axis, double stretch,
+                             std::string_view where = "uniaxial");
+
 /// Plane strain: a 2×2 F is embedded as diag(F, 1) (F₃₃ = 1, no out-of-plane shear) and the
 /// 3D law is evaluated; P and A are its in-plane parts. Energies are per unit volume (per
 /// unit thickness and area). Fibre directions must lie in the x–y plane.

@@ -8,11 +8,16 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <optional>
+#include <sstream>
+#include <type_traits>
 #include <vector>
 
+#include "coapt/core/collective.hpp"
 #include "coapt/core/context.hpp"
 #include "coapt/core/log.hpp"
 #include "coapt/core/timer.hpp"
@@ -23,6 +28,7 @@
 #include "coapt/mesh/mesh_input.hpp"
 #include "coapt/solid/dynamics.hpp"
 #include "coapt/solid/elements.hpp"
+#include "coapt/solid/mixed_elements.hpp"
 
 namespace coapt::solid {
 namespace detail {
@@ -34,6 +40,13 @@ struct ProbeLocation {
   int owner = -1;  ///< rank that evaluates it (lowest rank with an owned cell containing it)
   int cell = -1;   ///< local cell on the owner
   std::vector<double> barycentric;
+};
+
+/// A boundary facet under a follower pressure, seen from the local cell it bounds.
+struct PressureFacet {
+  int facet = -1;
+  double pressure = 0;         ///< p [Pa] at load factor 1
+  std::array<int, 3> local{};  ///< position in the cell of each facet vertex
 };
 
 /// Applies `operation(k)` for every owned entry k of the vectors, with raw arrays.
@@ -107,7 +120,10 @@ class SolidModelImpl {
     MPI_Comm_rank(comm_, &rank_);
     parameters_.check_dimension(dim_);
     assign_bodies();
+    assign_fibres();
+    collect_pressures();
     collect_dirichlet();
+    if (parameters_.mixed) setup_mixed();
     locate_probes();
     fem::set_rigid_body_modes(mesh_, matrix_.mat());
     if (parameters_.time.dynamic) {
@@ -133,8 +149,14 @@ class SolidModelImpl {
     log::info("mesh: {} cells, {} vertices, {} rank(s); cell measure in [{:.3e}, {:.3e}]",
               mesh_.n_global_cells, mesh_.n_global_vertices, size_of(comm_), quality_.min_measure,
               quality_.max_measure);
-    for (const auto& body : parameters_.bodies)
+    for (const auto& body : parameters_.bodies) {
       log::info("body '{}': {}, density {:g} kg/m^3", body.name, name(body.material), body.density);
+      if (const auto* law = std::get_if<FibreReinforced>(&body.material))
+        log::info("body '{}': fibres {}", body.name,
+                  body.fibre_field.describe(law->n_fibre_families));
+    }
+    for (const auto& load : parameters_.pressures)
+      log::info("follower pressure on '{}': {:g} Pa", load.boundary, load.pressure);
     if (density_offset_ != 0)
       log::info("inertia density: body density - {:g} kg/m^3", density_offset_);
     if (parameters_.time.dynamic)
@@ -145,7 +167,13 @@ class SolidModelImpl {
     log::info("Newton: relative tolerance {:g}, absolute {:g}, update {:g}, at most {} its",
               parameters_.newton.relative_tolerance, parameters_.newton.absolute_tolerance,
               parameters_.newton.update_tolerance, parameters_.newton.max_iterations);
-    log::info("linear solver: {}", solver_.describe());
+    if (parameters_.mixed)
+      log::info(
+          "formulation: mixed P1-P1 displacement-pressure, Brezzi-Pitkaranta alpha = {:g}; "
+          "linear solver: {}",
+          kPressureStabilisation, mixed_solver_->describe());
+    else
+      log::info("linear solver: {}", solver_.describe());
   }
 
   // --- access -------------------------------------------------------------------------------
@@ -161,7 +189,13 @@ class SolidModelImpl {
   Vec velocity() const { return v_.get(); }
   Vec acceleration() const { return a_.get(); }
   void set_external_force(Vec force) { extra_force_ = force; }
-  void set_hook(NewtonHook* hook) { hook_ = hook; }
+  void set_hook(NewtonHook* hook) {
+    if (hook && parameters_.mixed)
+      throw InputError(
+          "solid: formulation: mixed cannot be combined with a Newton hook (contact) yet: use "
+          "formulation: displacement");
+    hook_ = hook;
+  }
 
   void set_density_offset(double offset) {
     for (const auto& body : parameters_.bodies)
@@ -176,6 +210,7 @@ class SolidModelImpl {
 
   StepReport solve_static(double factor, run::RunOutput& output, const std::string& label,
                           bool verbose) {
+    if (parameters_.mixed) return solve_static_mixed(factor, output, label, verbose);
     set_dirichlet(u_, factor);
     fem::update_ghosts(u_);
     const auto residual_norm = [&] {
@@ -372,7 +407,315 @@ class SolidModelImpl {
       write_vtk<3>(output, time, extra);
   }
 
+  enum class Average { deformation_gradient, cauchy_stress };
+
+  /// ∫ F dX / ∫ dX or ∫ σ dx / ∫ dx over the owned cells of every rank. Collective.
+  std::array<double, 9> mean(Average what) const {
+    return dim_ == 2 ? mean<2>(what) : mean<3>(what);
+  }
+
+  template <int Dim>
+  std::array<double, 9> mean(Average what) const {
+    fem::LocalValues values(u_.get());
+    std::array<double, 10> sum{};  // 9 components and the volume
+    for (int c = 0; c < mesh_.n_owned_cells; ++c) {
+      const auto g = geometry<Dim>(c);
+      const MatrixD<Dim> F = deformation_gradient<Dim>(g.gradients, nodal<Dim>(values, c));
+      Matrix3 value = Matrix3::Identity();
+      double weight = g.measure;
+      if (what == Average::deformation_gradient) {
+        value.topLeftCorner<Dim, Dim>() = F;
+      } else {
+        value = cauchy_stress<Dim>(body(c).material, F, fibres(c));
+        weight *= F.determinant();
+      }
+      for (int k = 0; k < 9; ++k) sum[k] += weight * value(k / 3, k % 3);
+      sum[9] += weight;
+    }
+    MPI_Allreduce(MPI_IN_PLACE, sum.data(), 10, MPI_DOUBLE, MPI_SUM, comm_);
+    std::array<double, 9> result{};
+    for (int k = 0; k < 9; ++k) result[k] = sum[k] / sum[9];
+    return result;
+  }
+
+  /// Σ of f_int(u) (with the follower pressures at the last load factor) over the owned
+  /// vertices of a boundary group. Collective.
+  std::vector<double> reaction_force(const std::string& boundary) const {
+    const int tag = facet_tag(boundary, "reaction_force");
+    auto force = fem::create_vertex_vector(mesh_, dim_);
+    fem::LocalValues values(u_.get());
+    const auto element_forces = [&](auto dimension, int c, double* element) {
+      constexpr int Dim = decltype(dimension)::value;
+      const NodalValues<Dim> displacement = nodal<Dim>(values, c);
+      const auto r =
+          element_residual<Dim>(geometry<Dim>(c), body(c).material, fibres(c), displacement);
+      std::copy(r.data(), r.data() + r.size(), element);
+      add_pressure<Dim>(c, displacement, pressure_factor_, false, element);
+    };
+    fem::assemble_vector(mesh_, dim_, force, [&](int c, double* element) {
+      if (dim_ == 2)
+        element_forces(std::integral_constant<int, 2>{}, c, element);
+      else
+        element_forces(std::integral_constant<int, 3>{}, c, element);
+    });
+    std::vector<double> total(static_cast<std::size_t>(dim_), 0.0);
+    {
+      ReadArray data(force);
+      for (int i = 0; i < dim_; ++i) {
+        const int component[1] = {i};
+        for (PetscInt dof : fem::boundary_dofs(mesh_, dim_, tag, component))
+          total[static_cast<std::size_t>(i)] += data[dof - mesh_.vertex_offset * dim_];
+      }
+    }
+    MPI_Allreduce(MPI_IN_PLACE, total.data(), dim_, MPI_DOUBLE, MPI_SUM, comm_);
+    return total;
+  }
+
+  // --- mixed displacement-pressure formulation (mixed_elements.hpp) --------------------------
+
+  /// One quasi-static load step of the mixed formulation: Newton on (u, p) with the stopping
+  /// rules of newton_solve; u_ follows the displacement part after every update.
+  StepReport solve_static_mixed(double factor, run::RunOutput& output, const std::string& label,
+                                bool verbose) {
+    const auto& newton = parameters_.newton;
+    const int m = dim_ + 1;
+    set_dirichlet(u_, factor);
+    {
+      ReadArray u(u_);
+      WriteArray w(mixed_state_);
+      for (int v = 0; v < mesh_.n_owned_vertices; ++v)
+        for (int i = 0; i < dim_; ++i) w[v * m + i] = u[v * dim_ + i];
+    }
+    fem::update_ghosts(mixed_state_);
+    const auto residual_norm = [&] {
+      ScopedTimer timer(output.timers(), "assemble");
+      return assemble_mixed_residual(factor);
+    };
+    StepReport report;
+    auto& history = report.history;
+    double norm = residual_norm();
+    if (!std::isfinite(norm))
+      throw ConvergenceError(
+          fmt::format("solid: {}: the prescribed displacements invert a cell", label));
+    history.push_back(norm);
+    if (verbose) log::info("{}: newton 0  |R| = {:.6e}", label, norm);
+    auto rhs = fem::create_vertex_vector(mesh_, m);
+    auto update = fem::create_vertex_vector(mesh_, m);
+    auto zero = fem::create_vertex_vector(mesh_, m);
+    const double tolerance =
+        std::max(newton.relative_tolerance * history.front(), newton.absolute_tolerance);
+    bool small_update = false;
+    while (norm > tolerance && !small_update) {
+      if (report.newton_iterations == newton.max_iterations)
+        throw ConvergenceError(
+            fmt::format("solid: Newton (mixed) did not converge in {} within {} iterations: |R| = "
+                        "[{:.3e}] (tolerance {:.3e})",
+                        label, newton.max_iterations, fmt::join(history, ", "), tolerance));
+      ++report.newton_iterations;
+      {
+        ScopedTimer timer(output.timers(), "assemble");
+        assemble_mixed_tangent(factor);
+        COAPT_PETSC_CHECK(VecCopy(mixed_residual_, rhs));
+        COAPT_PETSC_CHECK(VecScale(rhs, -1.0));
+        fem::apply_dirichlet(mixed_matrix_->mat(), rhs, mixed_dirichlet_dofs_, zero);
+      }
+      fem::SolveStats stats;
+      {
+        ScopedTimer timer(output.timers(), "solve");
+        mixed_solver_->set_operator(mixed_matrix_->mat());
+        COAPT_PETSC_CHECK(VecSet(update, 0.0));
+        stats = mixed_solver_->solve(rhs, update);
+      }
+      zero_mixed_dirichlet(update);
+      report.linear_iterations += stats.iterations;
+      double step_length = 1.0;
+      COAPT_PETSC_CHECK(VecAXPY(mixed_state_, step_length, update));
+      fem::update_ghosts(mixed_state_);
+      norm = residual_norm();
+      for (int halving = 0; !std::isfinite(norm) && halving < 12; ++halving) {
+        step_length *= 0.5;
+        COAPT_PETSC_CHECK(VecAXPY(mixed_state_, -step_length, update));
+        fem::update_ghosts(mixed_state_);
+        norm = residual_norm();
+      }
+      if (!std::isfinite(norm))
+        throw ConvergenceError(fmt::format(
+            "solid: {}: every Newton step inverts a cell (|R| history [{:.3e}]); use more load "
+            "steps",
+            label, fmt::join(history, ", ")));
+      history.push_back(norm);
+      PetscReal update_norm = 0, state_norm = 0;
+      COAPT_PETSC_CHECK(VecNorm(update, NORM_2, &update_norm));
+      COAPT_PETSC_CHECK(VecNorm(mixed_state_, NORM_2, &state_norm));
+      small_update = step_length * update_norm <= newton.update_tolerance * state_norm;
+      const std::string line = fmt::format(
+          "{}: newton {}  |R| = {:.6e}  (|R|/|R0| = {:.3e}, step {:g}, {} linear its)", label,
+          report.newton_iterations, norm, norm / history.front(), step_length, stats.iterations);
+      if (verbose)
+        log::info("{}", line);
+      else
+        log::debug("{}", line);
+    }
+    {
+      ReadArray w(mixed_state_);
+      WriteArray u(u_);
+      for (int v = 0; v < mesh_.n_owned_vertices; ++v)
+        for (int i = 0; i < dim_; ++i) u[v * dim_ + i] = w[v * m + i];
+    }
+    fem::update_ghosts(u_);
+    return report;
+  }
+
  private:
+  void setup_mixed() {
+    const int m = dim_ + 1;
+    mixed_state_ = fem::create_vertex_vector(mesh_, m);
+    mixed_residual_ = fem::create_vertex_vector(mesh_, m);
+    mixed_matrix_.emplace(mesh_, m);
+    // A direct solver: the stabilised saddle-point system is indefinite, and AMG on it needs a
+    // block preconditioner; -solid_ksp_type / -solid_pc_type choose another.
+    mixed_solver_.emplace(comm_, "solid_",
+                          fem::LinearSolverDefaults{"preonly", "lu", 1e-10, 1e-50, 2000});
+    PetscBool given = PETSC_FALSE;
+    COAPT_PETSC_CHECK(PetscOptionsHasName(nullptr, "solid_", "-pc_factor_mat_solver_type", &given));
+    PC pc = nullptr;
+    COAPT_PETSC_CHECK(KSPGetPC(mixed_solver_->ksp(), &pc));
+    if (!given) COAPT_PETSC_CHECK(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+    for (PetscInt dof : dirichlet_dofs_)
+      mixed_dirichlet_dofs_.push_back(dof / dim_ * m + dof % dim_);
+    cell_size_.resize(static_cast<std::size_t>(mesh_.n_cells()));
+    for (int c = 0; c < mesh_.n_cells(); ++c) {
+      double h = 0;
+      const auto vertices = mesh_.cell(c);
+      for (int a = 0; a <= dim_; ++a)
+        for (int b = a + 1; b <= dim_; ++b) {
+          double squared = 0;
+          for (int d = 0; d < dim_; ++d) {
+            const double e = mesh_.point(vertices[a])[d] - mesh_.point(vertices[b])[d];
+            squared += e * e;
+          }
+          h = std::max(h, std::sqrt(squared));
+        }
+      cell_size_[static_cast<std::size_t>(c)] = h;
+    }
+    // The pressure unknown is p / S with S = μ_max / h_mean, so that the u–u, u–p and p–p
+    // blocks are all of order μ (in physical units they differ by factors h and h², 10 orders
+    // of magnitude on a mm mesh, which defeats the pivoting of a direct solver).
+    double sums[2] = {0.0, static_cast<double>(mesh_.n_owned_cells)};
+    for (int c = 0; c < mesh_.n_owned_cells; ++c)
+      sums[0] += cell_size_[static_cast<std::size_t>(c)];
+    MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE, MPI_SUM, comm_);
+    double shear_max = 0;
+    for (const auto& body : parameters_.bodies) {
+      double bulk = 0, shear = 0;
+      volumetric_split(body.material, bulk, shear);
+      shear_max = std::max(shear_max, shear);
+    }
+    pressure_scale_ = shear_max / (sums[0] / sums[1]);
+  }
+
+  void zero_mixed_dirichlet(Vec vector) {
+    WriteArray data(vector);
+    for (PetscInt dof : mixed_dirichlet_dofs_) data[dof - mesh_.vertex_offset * (dim_ + 1)] = 0.0;
+  }
+
+  template <int Dim>
+  MixedNodalValues<Dim> mixed_nodal(const fem::LocalValues& w, int c) const {
+    MixedNodalValues<Dim> values;
+    const auto vertices = mesh_.cell(c);
+    for (int a = 0; a <= Dim; ++a)
+      for (int i = 0; i <= Dim; ++i)
+        values(a, i) = w[static_cast<std::size_t>(vertices[a]) * (Dim + 1) + i];
+    values.col(Dim) *= pressure_scale_;  // the state holds p / S
+    return values;
+  }
+
+  double assemble_mixed_residual(double factor) {
+    pressure_factor_ = factor;
+    return dim_ == 2 ? assemble_mixed_residual<2>(factor) : assemble_mixed_residual<3>(factor);
+  }
+
+  /// The mixed residual into mixed_residual_ (Dirichlet rows zeroed): ‖R‖, +∞ when a cell
+  /// inverts. Collective.
+  template <int Dim>
+  double assemble_mixed_residual(double factor) {
+    constexpr int m = Dim + 1;
+    double min_J = std::numeric_limits<double>::infinity();
+    {
+      fem::LocalValues values(mixed_state_.get());
+      fem::assemble_vector(mesh_, m, mixed_residual_, [&](int c, double* element) {
+        const MixedNodalValues<Dim> w = mixed_nodal<Dim>(values, c);
+        MixedElementVector<Dim> r;
+        const double J = mixed_element<Dim>(geometry<Dim>(c), cell_size_[c], body(c).material,
+                                            fibres(c), w, r, nullptr);
+        min_J = std::isfinite(J) ? std::min(min_J, J) : -1.0;
+        if (!(J > 0.0)) return;
+        for (int a = 0; a <= Dim; ++a) r(a * m + Dim) *= pressure_scale_;
+        std::copy(r.data(), r.data() + r.size(), element);
+        ElementVector<Dim> pressure = ElementVector<Dim>::Zero();
+        add_pressure<Dim>(c, w.template leftCols<Dim>(), factor, false, pressure.data());
+        for (int a = 0; a <= Dim; ++a)
+          for (int i = 0; i < Dim; ++i) element[a * m + i] += pressure(a * Dim + i);
+      });
+    }
+    MPI_Allreduce(MPI_IN_PLACE, &min_J, 1, MPI_DOUBLE, MPI_MIN, comm_);
+    if (!(min_J > 0.0)) return std::numeric_limits<double>::infinity();
+    {
+      WriteArray R(mixed_residual_);
+      ReadArray f(external_);
+      std::optional<ReadArray> extra;
+      if (extra_force_) extra.emplace(extra_force_);
+      for (int v = 0; v < mesh_.n_owned_vertices; ++v)
+        for (int i = 0; i < Dim; ++i) {
+          R[v * m + i] -= factor * f[v * Dim + i];
+          if (extra) R[v * m + i] -= (*extra)[v * Dim + i];
+        }
+    }
+    zero_mixed_dirichlet(mixed_residual_);
+    PetscReal norm = 0;
+    COAPT_PETSC_CHECK(VecNorm(mixed_residual_, NORM_2, &norm));
+    return std::isfinite(norm) ? norm : std::numeric_limits<double>::infinity();
+  }
+
+  void assemble_mixed_tangent(double factor) {
+    if (dim_ == 2)
+      assemble_mixed_tangent<2>(factor);
+    else
+      assemble_mixed_tangent<3>(factor);
+  }
+
+  template <int Dim>
+  void assemble_mixed_tangent(double factor) {
+    constexpr int m = Dim + 1, n = (Dim + 1) * m, nd = (Dim + 1) * Dim;
+    fem::LocalValues values(mixed_state_.get());
+    mixed_matrix_->assemble([&](int c, double* element) {
+      const MixedNodalValues<Dim> w = mixed_nodal<Dim>(values, c);
+      MixedElementVector<Dim> r;
+      MixedElementMatrix<Dim> K;
+      mixed_element<Dim>(geometry<Dim>(c), cell_size_[c], body(c).material, fibres(c), w, r, &K);
+      for (int a = 0; a <= Dim; ++a) {
+        K.row(a * m + Dim) *= pressure_scale_;
+        K.col(a * m + Dim) *= pressure_scale_;
+      }
+      std::copy(K.data(), K.data() + K.size(), element);
+      ElementMatrix<Dim> pressure = ElementMatrix<Dim>::Zero();
+      add_pressure<Dim>(c, w.template leftCols<Dim>(), factor, true, pressure.data());
+      for (int a = 0; a < nd; ++a)
+        for (int b = 0; b < nd; ++b)
+          element[(a / Dim * m + a % Dim) * n + b / Dim * m + b % Dim] += pressure(a, b);
+    });
+  }
+
+  /// The mixed pressure per local vertex [Pa] (empty for the displacement formulation).
+  std::vector<double> mixed_pressure() const {
+    if (!parameters_.mixed) return {};
+    fem::LocalValues values(mixed_state_.get());
+    std::vector<double> pressure(static_cast<std::size_t>(mesh_.n_vertices()));
+    for (std::size_t v = 0; v < pressure.size(); ++v)
+      pressure[v] = pressure_scale_ * values[v * (dim_ + 1) + dim_];
+    return pressure;
+  }
+
   // --- setup -------------------------------------------------------------------------------
 
   /// body_of_cell_[c] for every local cell; an InputError (on every rank) if an owned cell
@@ -406,6 +749,106 @@ class SolidModelImpl {
           fmt::format("{}: {} cell(s) of {} belong to no body (list their groups in "
                       "cell_groups, or leave one body without cell_groups)",
                       parameters_.bodies.front().where, unassigned, mesh_.source));
+  }
+
+  /// fibres_of_cell_ for every local cell from each body's fibre rule; in 2D every direction
+  /// must lie in the x-y plane. InputError (on every rank) naming the element (its number in
+  /// the mesh source) or the file and line.
+  void assign_fibres() {
+    const std::size_t n_cells = static_cast<std::size_t>(mesh_.n_cells());
+    fibres_of_cell_.assign(n_cells, FibreDirections{});
+    for (std::size_t b = 0; b < parameters_.bodies.size(); ++b) {
+      const auto& body = parameters_.bodies[b];
+      const auto* law = std::get_if<FibreReinforced>(&body.material);
+      if (!law) continue;
+      const auto& field = body.fibre_field;
+      std::vector<int> cells;  // owned first, then ghosts
+      for (int pass = 0; pass < 2; ++pass)
+        for (int c = pass == 0 ? 0 : mesh_.n_owned_cells;
+             c < (pass == 0 ? mesh_.n_owned_cells : mesh_.n_cells()); ++c)
+          if (body_of_cell_[c] == static_cast<int>(b)) cells.push_back(c);
+      std::size_t n_owned = 0;
+      while (n_owned < cells.size() && cells[n_owned] < mesh_.n_owned_cells) ++n_owned;
+      const auto element_name = [&](int c) {
+        return fmt::format("{}: element {} of {}", field.where, mesh_.original_cell[c],
+                           mesh_.source);
+      };
+      std::string message;
+      if (field.rule == FibreFieldParameters::Rule::file) {
+        std::string text;
+        try {
+          std::ifstream stream(field.file);
+          if (!stream)
+            throw InputError(fmt::format("{}: file: cannot read '{}'", field.where, field.file));
+          std::ostringstream buffer;
+          buffer << stream.rdbuf();
+          text = buffer.str();
+        } catch (const InputError& e) {
+          message = e.what();
+        }
+        rethrow_collectively(comm_, message, true);
+        std::vector<std::int64_t> elements;
+        elements.reserve(cells.size());
+        for (int c : cells) elements.push_back(mesh_.original_cell[c]);
+        const auto directions =
+            fibres_from_csv(text, field.file, elements, n_owned, law->n_fibre_families, comm_);
+        for (std::size_t k = 0; k < cells.size(); ++k) fibres_of_cell_[cells[k]] = directions[k];
+      }
+      try {
+        for (int c : cells) {
+          auto& fibres = fibres_of_cell_[c];
+          if (field.rule == FibreFieldParameters::Rule::constant) {
+            fibres = field.constant;
+          } else if (field.rule == FibreFieldParameters::Rule::circumferential) {
+            Vector3 centroid = Vector3::Zero();
+            for (int v : mesh_.cell(c))
+              for (int d = 0; d < dim_; ++d) centroid(d) += mesh_.point(v)[d] / (dim_ + 1);
+            fibres = circumferential_fibres(field, centroid, element_name(c));
+          }
+          if (law->n_fibre_families < kMaxFibreFamilies) fibres.a0[1].setZero();
+          if (dim_ == 2)
+            for (int f = 0; f < law->n_fibre_families; ++f)
+              if (std::abs(fibres.a0[f].z()) > 1e-12)
+                throw InputError(fmt::format("{}: fibre direction {} leaves the x-y plane",
+                                             element_name(c), f + 1));
+        }
+      } catch (const InputError& e) {
+        message = e.what();
+      }
+      rethrow_collectively(comm_, message, true);
+    }
+  }
+
+  /// pressure_facets_ grouped by local cell (owned and ghost: the tangent assembly visits
+  /// ghost cells too), pressure_offset_ their CSR offsets. Nothing when the case has no
+  /// pressures.
+  void collect_pressures() {
+    if (parameters_.pressures.empty()) return;
+    std::vector<std::pair<int, PressureFacet>> found;  // cell, facet
+    for (const auto& load : parameters_.pressures) {
+      const int tag = facet_tag(load.boundary, load.where);
+      for (int f = 0; f < mesh_.n_facets(); ++f) {
+        if (mesh_.facet_tags[f] != tag) continue;
+        const int c = mesh_.facet_cell[f];
+        PressureFacet entry;
+        entry.facet = f;
+        entry.pressure = load.pressure;
+        const auto vertices = mesh_.cell(c);
+        for (int a = 0; a < dim_; ++a) {
+          const int v = mesh_.facets[static_cast<std::size_t>(f) * dim_ + a];
+          entry.local[a] =
+              static_cast<int>(std::find(vertices.begin(), vertices.end(), v) - vertices.begin());
+        }
+        found.emplace_back(c, entry);
+      }
+    }
+    std::stable_sort(found.begin(), found.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    pressure_offset_.assign(static_cast<std::size_t>(mesh_.n_cells()) + 1, 0);
+    for (const auto& [c, entry] : found) ++pressure_offset_[static_cast<std::size_t>(c) + 1];
+    for (std::size_t c = 0; c + 1 < pressure_offset_.size(); ++c)
+      pressure_offset_[c + 1] += pressure_offset_[c];
+    for (auto& [c, entry] : found) pressure_facets_.push_back(entry);
   }
 
   int facet_tag(const std::string& name, const std::string& where) const {
@@ -508,6 +951,8 @@ class SolidModelImpl {
   }
 
   const BodyParameters& body(int c) const { return parameters_.bodies[body_of_cell_[c]]; }
+  /// Fibre directions of local cell c (zero vectors for the isotropic laws).
+  const FibreDirections& fibres(int c) const { return fibres_of_cell_[c]; }
 
   /// The full external load f_ext (gravity and tractions at load factor 1). Collective.
   template <int Dim>
@@ -577,6 +1022,37 @@ class SolidModelImpl {
     }
   }
 
+  /// Adds the follower-pressure terms of cell c's facets at load factor `factor` to its element
+  /// vector (`matrix` false) or element matrix (`matrix` true), node-major.
+  template <int Dim>
+  void add_pressure(int c, const NodalValues<Dim>& displacement, double factor, bool matrix,
+                    double* element) const {
+    if (pressure_offset_.empty() || factor == 0.0) return;
+    constexpr int n = (Dim + 1) * Dim;
+    const auto vertices = mesh_.cell(c);
+    for (int k = pressure_offset_[c]; k < pressure_offset_[c + 1]; ++k) {
+      const auto& entry = pressure_facets_[static_cast<std::size_t>(k)];
+      FacetPositions<Dim> x;
+      for (int a = 0; a < Dim; ++a)
+        for (int i = 0; i < Dim; ++i)
+          x(a, i) = mesh_.point(vertices[entry.local[a]])[i] + displacement(entry.local[a], i);
+      const double p = factor * entry.pressure;
+      if (matrix) {
+        const FacetMatrix<Dim> K = pressure_facet_tangent<Dim>(x, p);
+        for (int a = 0; a < Dim; ++a)
+          for (int i = 0; i < Dim; ++i)
+            for (int b = 0; b < Dim; ++b)
+              for (int j = 0; j < Dim; ++j)
+                element[(entry.local[a] * Dim + i) * n + entry.local[b] * Dim + j] +=
+                    K(a * Dim + i, b * Dim + j);
+      } else {
+        const FacetVector<Dim> r = pressure_facet_residual<Dim>(x, p);
+        for (int a = 0; a < Dim; ++a)
+          for (int i = 0; i < Dim; ++i) element[entry.local[a] * Dim + i] += r(a * Dim + i);
+      }
+    }
+  }
+
   /// R = f_int(u) − s f_ext − f_extra (+ M a when `inertia` holds M a) + the hook's terms into
   /// residual_ with the Dirichlet rows zeroed; returns ‖R‖₂, or +∞ when some cell is inverted
   /// (det F ≤ 0 or not finite) on any rank. Collective.
@@ -587,6 +1063,7 @@ class SolidModelImpl {
 
   template <int Dim>
   double assemble_residual(Vec u, double factor, Vec inertia) {
+    pressure_factor_ = factor;  // the tangent that follows is taken at the same load factor
     double min_J = std::numeric_limits<double>::infinity();
     {
       fem::LocalValues values(u);
@@ -596,8 +1073,9 @@ class SolidModelImpl {
         const double J = deformation_gradient<Dim>(g.gradients, displacement).determinant();
         min_J = std::isfinite(J) ? std::min(min_J, J) : -1.0;
         if (!(J > 0.0)) return;  // the whole residual is rejected below
-        const auto r = element_residual<Dim>(g, body(c).material, body(c).fibres, displacement);
+        const auto r = element_residual<Dim>(g, body(c).material, fibres(c), displacement);
         std::copy(r.data(), r.data() + r.size(), element);
+        add_pressure<Dim>(c, displacement, factor, false, element);
       });
     }
     MPI_Allreduce(MPI_IN_PLACE, &min_J, 1, MPI_DOUBLE, MPI_MIN, comm_);
@@ -624,9 +1102,11 @@ class SolidModelImpl {
   void assemble_tangent(Vec u, double mass_factor) {
     fem::LocalValues values(u);
     matrix_.assemble([&](int c, double* element) {
-      const auto K = element_tangent<Dim>(geometry<Dim>(c), body(c).material, body(c).fibres,
-                                          nodal<Dim>(values, c));
+      const NodalValues<Dim> displacement = nodal<Dim>(values, c);
+      const auto K =
+          element_tangent<Dim>(geometry<Dim>(c), body(c).material, fibres(c), displacement);
       std::copy(K.data(), K.data() + K.size(), element);
+      add_pressure<Dim>(c, displacement, pressure_factor_, true, element);
       if (mass_factor != 0) add_element_mass(c, mass_factor, element);
     });
   }
@@ -675,9 +1155,9 @@ class SolidModelImpl {
       if (integrand == Integrand::volume)
         sum += g.measure * F.determinant();
       else if constexpr (Dim == 2)
-        sum += g.measure * plane_strain::energy(body(c).material, F, body(c).fibres);
+        sum += g.measure * plane_strain::energy(body(c).material, F, fibres(c));
       else
-        sum += g.measure * solid::energy(body(c).material, F, body(c).fibres);
+        sum += g.measure * solid::energy(body(c).material, F, fibres(c));
     }
     MPI_Allreduce(MPI_IN_PLACE, &sum, 1, MPI_DOUBLE, MPI_SUM, comm_);
     return sum;
@@ -780,7 +1260,7 @@ class SolidModelImpl {
     for (int c = 0; c < mesh_.n_owned_cells; ++c) {
       const MatrixD<Dim> F =
           deformation_gradient<Dim>(geometry<Dim>(c).gradients, nodal<Dim>(values, c));
-      const Matrix3 sigma = cauchy_stress<Dim>(body(c).material, F, body(c).fibres);
+      const Matrix3 sigma = cauchy_stress<Dim>(body(c).material, F, fibres(c));
       for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j)
           stress[static_cast<std::size_t>(c) * 9 + 3 * i + j] = sigma(i, j);
@@ -797,6 +1277,21 @@ class SolidModelImpl {
     };
     if (mass_)
       fields.push_back({"velocity", Dim, io::Field::Location::vertex, velocities.values()});
+    if (parameters_.mixed)
+      fields.push_back({"pressure", 1, io::Field::Location::vertex, mixed_pressure()});
+    // Reference fibre directions a₀ of each family, where some body has that family.
+    for (int f = 0; f < kMaxFibreFamilies; ++f) {
+      bool present = false;
+      for (const auto& b : parameters_.bodies)
+        if (const auto* law = std::get_if<FibreReinforced>(&b.material))
+          present = present || law->n_fibre_families > f;
+      if (!present) continue;
+      std::vector<double> directions(n_cells * 3);
+      for (std::size_t c = 0; c < n_cells; ++c)
+        for (int i = 0; i < 3; ++i) directions[c * 3 + i] = fibres_of_cell_[c].a0[f](i);
+      fields.push_back({f == 0 ? "fibre_direction" : "second_fibre_direction", 3,
+                        io::Field::Location::cell, std::move(directions)});
+    }
     fields.insert(fields.end(), extra.begin(), extra.end());
     output.vtk("solid").write(mesh_, time, fields);
   }
@@ -808,8 +1303,19 @@ class SolidModelImpl {
   int dim_;
   int rank_ = 0;
   std::vector<int> body_of_cell_;
-  std::vector<PetscInt> dirichlet_dofs_;  ///< owned, sorted
-  std::vector<double> dirichlet_values_;  ///< final value of each, [m]
+  std::vector<FibreDirections> fibres_of_cell_;  ///< per local cell
+  std::vector<PressureFacet> pressure_facets_;   ///< grouped by local cell
+  std::vector<int> pressure_offset_;             ///< CSR offsets into it (empty: no pressures)
+  double pressure_factor_ = 1.0;                 ///< load factor of the last residual
+  // Mixed formulation (parameters_.mixed): state (u, p) per vertex, residual, matrix, solver.
+  OwnedVec mixed_state_, mixed_residual_;
+  std::optional<fem::P1Matrix> mixed_matrix_;
+  std::optional<fem::LinearSolver> mixed_solver_;
+  std::vector<PetscInt> mixed_dirichlet_dofs_;  ///< owned, in the (Dim+1)-component layout
+  std::vector<double> cell_size_;               ///< longest edge of each local cell [m]
+  double pressure_scale_ = 1.0;                 ///< S: the mixed state holds p / S [Pa]
+  std::vector<PetscInt> dirichlet_dofs_;        ///< owned, sorted
+  std::vector<double> dirichlet_values_;        ///< final value of each, [m]
   std::vector<ProbeLocation> probes_;
 
   OwnedVec u_, v_, a_;                                ///< trial state
@@ -908,6 +1414,15 @@ double SolidModel::external_work() const {
 }
 double SolidModel::volume() const {
   return impl_->volume();
+}
+std::array<double, 9> SolidModel::mean_deformation_gradient() const {
+  return impl_->mean(detail::SolidModelImpl::Average::deformation_gradient);
+}
+std::array<double, 9> SolidModel::mean_cauchy_stress() const {
+  return impl_->mean(detail::SolidModelImpl::Average::cauchy_stress);
+}
+std::vector<double> SolidModel::reaction_force(const std::string& boundary) const {
+  return impl_->reaction_force(boundary);
 }
 std::vector<double> SolidModel::current_coordinates() const {
   return impl_->current_coordinates();

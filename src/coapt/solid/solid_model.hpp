@@ -33,6 +33,7 @@
 #include <petscmat.h>
 #include <petscvec.h>
 
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -155,6 +156,14 @@ class SolidModel {
   double external_work() const;
   /// Current volume ∫ det F dX [m³, or m² in 2D].
   double volume() const;
+  /// Volume averages over the bodies: ∫ F dX / ∫ dX and ∫ σ dx / ∫ dx (current volume),
+  /// 3×3 row-major (F₃₃ = 1 and σ₃₃ included in plane strain).
+  std::array<double, 9> mean_deformation_gradient() const;
+  std::array<double, 9> mean_cauchy_stress() const;
+  /// Reaction on a boundary group: Σ over its vertices of the internal force f_int(u) (the
+  /// force the supports exert on the body, per unit thickness in 2D) [N], dim() components.
+  /// InputError when the group does not exist. Collective.
+  std::vector<double> reaction_force(const std::string& boundary) const;
   /// The current coordinates X + u of the local vertices (owned and ghost), row-major.
   std::vector<double> current_coordinates() const;
 

@@ -29,16 +29,6 @@ int component_index(const config::Section& section, const std::string& name) {
   section.fail("components", fmt::format("unknown component '{}' (use x, y, z)", name));
 }
 
-Vector3 read_direction(const config::Section& section, std::string_view key) {
-  const auto values =
-      section.get<std::vector<double>>(key, {}, {"", "unit fibre direction (reference)"});
-  if (values.size() < 2 || values.size() > 3)
-    section.fail(key, "expected 2 or 3 components (a 2D direction gets z = 0)");
-  Vector3 direction = Vector3::Zero();
-  for (std::size_t i = 0; i < values.size(); ++i) direction(static_cast<int>(i)) = values[i];
-  return direction;
-}
-
 }  // namespace
 
 Material read_material(const config::Section& section) {
@@ -128,10 +118,11 @@ SolidParameters SolidParameters::read(const config::Section& root) {
                                        {"kg/m^3", "reference density", Bounds::non_negative()});
     body.material = read_material(section.section("material", "constitutive law"));
     if (const auto* fibre_law = std::get_if<FibreReinforced>(&body.material)) {
-      body.fibres.a0[0] = read_direction(section, "fibre_direction");
-      if (fibre_law->n_fibre_families > 1)
-        body.fibres.a0[1] = read_direction(section, "second_fibre_direction");
-      validate_fibres(body.material, body.fibres, body.where);
+      body.fibre_field = FibreFieldParameters::read(section, fibre_law->n_fibre_families);
+      if (body.fibre_field.rule == FibreFieldParameters::Rule::constant) {
+        body.fibres = body.fibre_field.constant;
+        validate_fibres(body.material, body.fibres, body.fibre_field.where);
+      }
     }
     p.bodies.push_back(std::move(body));
   }
@@ -167,6 +158,16 @@ SolidParameters SolidParameters::read(const config::Section& root) {
                             : section.require<std::vector<double>>(
                                   "traction", {"Pa", "force per reference area (length in 2D)"});
     p.tractions.push_back(std::move(load));
+  }
+
+  for (const auto& section : root.sections(
+           "pressures", "follower pressures on boundary groups (current configuration)")) {
+    PressureParameters load;
+    load.where = located(section);
+    load.boundary = section.require<std::string>("boundary", {"", "boundary group"});
+    load.pressure = section.require<double>(
+        "pressure", {"Pa", "pressure p: load -p n da on the current boundary (n outward)"});
+    p.pressures.push_back(std::move(load));
   }
 
   p.gravity = root.get<std::vector<double>>("gravity", {}, {"m/s^2", "gravity (body force ρ g)"});
@@ -215,6 +216,71 @@ SolidParameters SolidParameters::read(const config::Section& root) {
     p.probes.push_back(std::move(probe));
   }
 
+  if (root.has("uniaxial_reference")) {
+    auto section = root.section("uniaxial_reference",
+                                "compare a homogeneous uniaxial stretch with its closed form");
+    p.uniaxial.enabled = true;
+    p.uniaxial.where = located(section);
+    const auto axis = section.require<std::vector<double>>("axis", {"", "stretch axis (3D)"});
+    if (axis.size() != 3) section.fail("axis", "expected 3 components (a 3D case)");
+    p.uniaxial.axis = Vector3(axis[0], axis[1], axis[2]);
+    if (!(p.uniaxial.axis.norm() > 0.0)) section.fail("axis", "must be non-zero");
+    p.uniaxial.axis.normalize();
+    p.uniaxial.reaction_boundary = section.get<std::string>(
+        "reaction_boundary", "", {"", "boundary whose reaction force is reported (empty: none)"});
+    p.uniaxial.reference_area =
+        section.get<double>("reference_area", 0.0,
+                            {"m^2", "reference area of reaction_boundary", Bounds::non_negative()});
+    if (p.bodies.size() != 1) section.fail("", "the closed form is for one body");
+    const auto& material = p.bodies.front().material;
+    const auto* fibre = std::get_if<FibreReinforced>(&material);
+    if (!fibre && !std::holds_alternative<NearlyIncompressibleNeoHookean>(material))
+      section.fail("",
+                   "the closed form is for nearly_incompressible_neo_hookean or "
+                   "fibre_reinforced");
+    if (fibre && p.bodies.front().fibre_field.rule != FibreFieldParameters::Rule::constant)
+      section.fail("", "the closed form needs constant fibre directions");
+  }
+
+  if (root.has("lame_reference")) {
+    auto section = root.section("lame_reference",
+                                "compare an inflated thick-walled cylinder with Lame's solution");
+    p.lame.enabled = true;
+    p.lame.where = located(section);
+    p.lame.inner_radius =
+        section.require<double>("inner_radius", {"m", "inner radius a", Bounds::positive()});
+    p.lame.outer_radius =
+        section.require<double>("outer_radius", {"m", "outer radius b", Bounds::positive()});
+    if (!(p.lame.outer_radius > p.lame.inner_radius))
+      section.fail("outer_radius", "must exceed inner_radius");
+    p.lame.inner_probe = section.require<std::string>(
+        "inner_probe", {"", "probe at r = a (its radial displacement)"});
+    p.lame.outer_probe = section.require<std::string>(
+        "outer_probe", {"", "probe at r = b (its radial displacement)"});
+    if (p.bodies.size() != 1) section.fail("", "Lame's solution is for one body");
+    if (p.pressures.size() != 1)
+      section.fail("", "Lame's solution needs exactly one entry in pressures (the inner one)");
+    if (std::holds_alternative<FibreReinforced>(p.bodies.front().material))
+      section.fail("", "Lame's solution is for an isotropic material");
+  }
+
+  p.mixed = root.choice("formulation", "displacement", {"displacement", "mixed"},
+                        {"",
+                         "displacement, or mixed: P1-P1 displacement-pressure against locking "
+                         "(nearly incompressible laws, static)"}) == "mixed";
+  if (p.mixed) {
+    if (p.time.dynamic)
+      root.fail("formulation", "the mixed formulation is static only (time.scheme: static)");
+    for (const auto& body : p.bodies)
+      if (!std::holds_alternative<NearlyIncompressibleNeoHookean>(body.material) &&
+          !std::holds_alternative<FibreReinforced>(body.material))
+        root.fail("formulation",
+                  fmt::format("the mixed formulation needs a law with a bulk modulus "
+                              "(nearly_incompressible_neo_hookean or fibre_reinforced); body '{}' "
+                              "is {}",
+                              body.name, name(body.material)));
+  }
+
   auto output = root.section("output", "what the run writes");
   p.write_vtk = output.get<bool>("vtk", true, {"", "write displacement and stresses as VTK"});
   p.vtk_interval = output.get<int>(
@@ -247,11 +313,18 @@ void SolidParameters::check_dimension(int dim) const {
   for (const auto& probe : probes) check(probe.point.size(), probe.where, "point");
   if (dim == 2)
     for (const auto& body : bodies)
-      if (std::holds_alternative<FibreReinforced>(body.material))
+      if (std::holds_alternative<FibreReinforced>(body.material)) {
+        const auto& field = body.fibre_field;
         for (const auto& a0 : body.fibres.a0)
           if (a0.z() != 0.0)
             throw InputError(
-                fmt::format("{}: plane strain needs fibres in the x-y plane", body.where));
+                fmt::format("{}: plane strain needs fibres in the x-y plane", field.where));
+        if (field.rule == FibreFieldParameters::Rule::circumferential &&
+            (std::abs(field.axis.z()) != 1.0 || field.angle != 0.0))
+          throw InputError(fmt::format(
+              "{}: plane strain needs fibres in the x-y plane: axis [0, 0, 1] and angle 0",
+              field.where));
+      }
 }
 
 }  // namespace coapt::solid

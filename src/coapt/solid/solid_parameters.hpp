@@ -8,19 +8,25 @@
 ///       cell_groups: [domain]          mesh cell groups (omitted: every cell no other body has)
 ///       density: 1000                  kg/m³ (for gravity; later for inertia)
 ///       material: {model: neo_hookean, young_modulus: ..., poisson_ratio: ...}
-///       fibre_direction: [1, 0, 0]     fibre_reinforced only (second_fibre_direction too)
+///       fibre_direction: [1, 0, 0]     fibre_reinforced only (second_fibre_direction too),
+///       fibres: {rule: circumferential, axis: [0, 0, 1]}   or per rule (fibre_field.hpp)
 ///   dirichlet:
 ///     - {boundary: left}                              all components fixed
 ///     - {boundary: top, components: [y], displacement: [0.001]}   ramped with the load
 ///   tractions:                         dead loads on the reference boundary, ramped
 ///     - {boundary: right, traction: [0, 62500]}       Pa (force per reference area/length)
 ///     - {boundary: right, total_force: [0, 1]}        N (3D) or N/m (2D): spread uniformly
+///   pressures:                         follower loads −p n da on the current boundary, ramped
+///     - {boundary: inner, pressure: 1000}             Pa
 ///   gravity: [0, -2]                   m/s², body force ρ g, ramped
+///   formulation: displacement          or mixed (P1-P1 u-p, nearly incompressible laws)
 ///   steps: 10                          load steps (load factor k/steps; static only)
 ///   time: {scheme: newmark, step: 0.005, end_time: 10, initial_velocity: [0, 0.1]}
 ///                                      dynamics (dynamics.hpp); scheme: static (default)
 ///   newton: {relative_tolerance, absolute_tolerance, update_tolerance, max_iterations}
 ///   probes: [{name: tip, point: [0.048, 0.060]}]
+///   uniaxial_reference: {axis: [1, 0, 0], reaction_boundary: right, reference_area: 1e-6}
+///   lame_reference: {inner_radius: 0.01, outer_radius: 0.02, inner_probe: a, outer_probe: b}
 ///   output: {vtk: true, vtk_interval: 10, checkpoint_interval: 100}
 ///                                      (time steps between VTK files / checkpoints)
 
@@ -29,6 +35,7 @@
 
 #include "coapt/core/config.hpp"
 #include "coapt/mesh/mesh_input.hpp"
+#include "coapt/solid/fibre_field.hpp"
 #include "coapt/solid/materials.hpp"
 
 namespace coapt::solid {
@@ -39,8 +46,9 @@ struct BodyParameters {
   std::vector<std::string> cell_groups;  ///< empty: the cells no other body claims
   double density = 0;                    ///< ρ [kg/m³]
   Material material;
-  FibreDirections fibres;  ///< constant over the body (fibre_reinforced only)
-  std::string where;       ///< location in the case file, for messages
+  FibreDirections fibres;            ///< fibre_reinforced with a constant rule: the directions
+  FibreFieldParameters fibre_field;  ///< fibre_reinforced: how the directions are given
+  std::string where;                 ///< location in the case file, for messages
 };
 
 /// Prescribed displacement of some components on a boundary group (ramped with the load).
@@ -56,6 +64,14 @@ struct TractionParameters {
   std::string boundary;
   std::vector<double> vector;  ///< traction [Pa] or, if `total`, total force [N, or N/m in 2D]
   bool total = false;
+  std::string where;
+};
+
+/// A follower pressure on a boundary group: the load −p n da on the current boundary
+/// (n outward), ramped with the load factor in static solves, constant in dynamics.
+struct PressureParameters {
+  std::string boundary;
+  double pressure = 0;  ///< p [Pa]
   std::string where;
 };
 
@@ -87,18 +103,45 @@ struct TimeParameters {
   std::string where;
 };
 
+/// A check of a homogeneous uniaxial stretch against the closed form (uniaxial_state): the
+/// case stretches a block of one nearly incompressible or fibre-reinforced body (constant
+/// fibres) along `axis` with free lateral faces; the benchmark gets the mean stretch, lateral
+/// stretch and axial Cauchy stress next to the closed form, and the reaction on a boundary.
+struct UniaxialReference {
+  bool enabled = false;
+  Vector3 axis = Vector3::UnitX();
+  std::string reaction_boundary;  ///< "" : no reaction reported
+  double reference_area = 0;      ///< reference area of that boundary [m²]
+  std::string where;
+};
+
+/// Lamé's thick-walled cylinder (closed_form.hpp): radii and the probes at r = a and r = b.
+struct LameReference {
+  bool enabled = false;
+  double inner_radius = 0;  ///< a [m]
+  double outer_radius = 0;  ///< b [m]
+  std::string inner_probe, outer_probe;
+  std::string where;
+};
+
 /// Everything `problem: solid` reads.
 struct SolidParameters {
   mesh::MeshInput mesh;
   std::vector<BodyParameters> bodies;
   std::vector<DirichletParameters> dirichlet;
   std::vector<TractionParameters> tractions;
+  std::vector<PressureParameters> pressures;
   std::vector<double> gravity;  ///< [m/s²], empty: none
   std::string gravity_where;
   int steps = 1;
   NewtonParameters newton;
   TimeParameters time;
   std::vector<ProbeParameters> probes;
+  UniaxialReference uniaxial;
+  /// `formulation: mixed`: P1–P1 displacement–pressure with pressure stabilisation
+  /// (mixed_elements.hpp) instead of the displacement formulation; static only.
+  bool mixed = false;
+  LameReference lame;
   bool write_vtk = true;
   int vtk_interval = 1;         ///< dynamics: VTK every this many time steps
   int checkpoint_interval = 0;  ///< dynamics: a checkpoint every this many steps (0: none)

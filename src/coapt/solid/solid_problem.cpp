@@ -4,14 +4,19 @@
 #include "coapt/solid/solid_problem.hpp"
 
 #include <fmt/format.h>
+#include <petscsys.h>
 
 #include <cmath>
+#include <memory>
 #include <vector>
 
+#include "coapt/contact/solid_contact.hpp"
+#include "coapt/core/error.hpp"
 #include "coapt/core/log.hpp"
 #include "coapt/core/progress.hpp"
 #include "coapt/core/timer.hpp"
 #include "coapt/io/json.hpp"
+#include "coapt/solid/closed_form.hpp"
 #include "coapt/solid/dynamics.hpp"
 #include "coapt/solid/solid_model.hpp"
 
@@ -20,11 +25,47 @@ namespace {
 
 constexpr const char* kComponentNames[3] = {"x", "y", "z"};
 
+/// Reads the `contact:` section; with contact, the solid's linear solver defaults to a direct
+/// one (MUMPS LU: the contact rows make the system non-symmetric with coupling that AMG does
+/// not expect) unless -solid_ksp_type or -solid_pc_type is given.
+contact::ContactParameters read_contact(const config::Section& root) {
+  auto parameters = contact::ContactParameters::read(root);
+  if (parameters.enabled()) {
+    PetscBool ksp = PETSC_FALSE, pc = PETSC_FALSE, factor = PETSC_FALSE;
+    COAPT_PETSC_CHECK(PetscOptionsHasName(nullptr, "solid_", "-ksp_type", &ksp));
+    COAPT_PETSC_CHECK(PetscOptionsHasName(nullptr, "solid_", "-pc_type", &pc));
+    COAPT_PETSC_CHECK(
+        PetscOptionsHasName(nullptr, "solid_", "-pc_factor_mat_solver_type", &factor));
+    if (!ksp && !pc) {
+      COAPT_PETSC_CHECK(PetscOptionsSetValue(nullptr, "-solid_ksp_type", "preonly"));
+      COAPT_PETSC_CHECK(PetscOptionsSetValue(nullptr, "-solid_pc_type", "lu"));
+      if (!factor)
+        COAPT_PETSC_CHECK(
+            PetscOptionsSetValue(nullptr, "-solid_pc_factor_mat_solver_type", "mumps"));
+    }
+  }
+  return parameters;
+}
+
 class SolidProblem final : public run::Problem {
  public:
-  SolidProblem(const config::Section& root, MPI_Comm comm) : solid_(root, comm) {}
+  SolidProblem(const config::Section& root, MPI_Comm comm)
+      : contact_parameters_(read_contact(root)),
+        hertz_(contact::HertzParameters::read(root)),
+        patch_test_(contact::PatchTestParameters::read(root)),
+        solid_(root, comm) {
+    if (contact_parameters_.enabled()) {
+      contact_ = std::make_unique<contact::ContactHook>(contact_parameters_, solid_);
+      solid_.set_hook(contact_.get());
+    }
+  }
 
-  void describe() const override { solid_.describe(); }
+  void describe() const override {
+    solid_.describe();
+    if (contact_)
+      log::info("contact (frictionless mortar, dual multipliers, semi-smooth Newton): {}",
+                contact_->constraints().describe());
+  }
 
   /// Newmark runs continue from a checkpoint of an earlier run (written every
   /// output.checkpoint_interval steps): the committed state, the step, and what the summary
@@ -76,8 +117,12 @@ class SolidProblem final : public run::Problem {
       series.add("residual_norm", report.norm());
       for (std::size_t p = 0; p < values.size(); ++p)
         for (int i = 0; i < dim(); ++i) series.add(probe_key(p, i), values[p][i]);
+      if (contact_) {
+        contact_->add_series(output);
+        contact_->log_status(fmt::format("load step {}/{}", step, steps));
+      }
       series.end_row();
-      if (parameters().write_vtk) solid_.write_vtk(output, factor);
+      if (parameters().write_vtk) write_vtk(output, factor);
     }
 
     const auto values = solid_.probe_values();
@@ -88,9 +133,73 @@ class SolidProblem final : public run::Problem {
         log::info("{} = {:.8e} m", probe_key(p, i), values[p][i]);
       }
     write_mesh_figures(benchmark);
+    write_closed_form_benchmark(solid_, benchmark);
+    if (contact_) {
+      write_contact_figures(benchmark);
+      contact_->write_nodes(output.directory() / "contact_nodes.csv", solid_.comm());
+    }
     auto& iterations = output.summary()["iterations"];
     iterations["newton"] = total_newton;
     iterations["linear"] = total_linear;
+  }
+
+  /// The solid's VTU fields, with the contact pressure, gap and active set under contact.
+  void write_vtk(run::RunOutput& output, double time) {
+    if (contact_)
+      solid_.write_vtk(output, time, contact_->fields());
+    else
+      solid_.write_vtk(output, time);
+  }
+
+  /// Contact state at the end, and the Hertz comparison when the case has `hertz:`.
+  void write_contact_figures(io::Json& benchmark) const {
+    const auto& status = contact_->constraints().status();
+    benchmark["contact_active_nodes"] = status.active;
+    benchmark["contact_total_force"] = status.total_force;
+    benchmark["contact_min_active_pressure"] = status.min_active_pressure;
+    benchmark["contact_max_penetration"] = status.max_penetration;
+    benchmark["contact_max_complementarity"] = status.max_complementarity;
+    benchmark["contact_max_open_pressure"] = status.max_open_pressure;
+    benchmark["contact_gap_tolerance"] = status.gap_tolerance;
+    benchmark["complementarity_constant"] = status.complementarity_constant;
+    benchmark["contact_pressure_relative_spread"] =
+        status.max_pressure > 0
+            ? (status.max_pressure - status.min_active_pressure) / status.max_pressure
+            : 0.0;
+    if (patch_test_.enabled) {
+      const double error = contact::pressure_error(contact_->constraints(), patch_test_.force);
+      const double force_error =
+          std::abs(status.total_force - patch_test_.force) / patch_test_.force;
+      benchmark["contact_pressure_error"] = error;
+      benchmark["contact_force_error"] = force_error;
+      log::info(
+          "patch test: pressure {:.10e} Pa (load / contact measure {:.10e}): max relative "
+          "deviation {:.3e} over {} active nodes; force {:.10e} (load {:g}, relative error "
+          "{:.3e})",
+          status.max_pressure, patch_test_.force / status.contact_measure, error, status.active,
+          status.total_force, patch_test_.force, force_error);
+    }
+    if (!hertz_.enabled) return;
+    const auto measured = contact::measure_hertz(contact_->constraints(), hertz_.sphere);
+    const std::string size = hertz_.sphere ? "contact_radius" : "contact_half_width";
+    benchmark["max_pressure"] = measured.max_pressure;
+    benchmark["max_pressure_analytic"] = hertz_.max_pressure();
+    benchmark[size] = measured.contact_size;
+    benchmark[size + "_analytic"] = hertz_.contact_size();
+    benchmark["fitted_max_pressure"] = measured.fitted_pressure;
+    benchmark["outermost_active_node"] = measured.outermost_active;
+    const auto error = [](double value, double reference) {
+      return std::abs(value - reference) / reference;
+    };
+    benchmark["max_pressure_error"] = error(measured.max_pressure, hertz_.max_pressure());
+    benchmark[size + "_error"] = error(measured.contact_size, hertz_.contact_size());
+    log::info(
+        "Hertz: max pressure {:.6e} Pa (analytic {:.6e}, error {:.3f} %), {} {:.6e} m "
+        "(analytic {:.6e}, error {:.3f} %), {} active nodes",
+        measured.max_pressure, hertz_.max_pressure(),
+        100 * error(measured.max_pressure, hertz_.max_pressure()), size, measured.contact_size,
+        hertz_.contact_size(), 100 * error(measured.contact_size, hertz_.contact_size()),
+        measured.active_nodes);
   }
 
   /// Newmark from the case's initial state; series.csv gets the probes and the energies
@@ -124,6 +233,7 @@ class SolidProblem final : public run::Problem {
       series.add("external_work", work);
       series.add("total_energy", total);
       series.add("newton_iterations", iterations);
+      if (contact_) contact_->add_series(output);
       series.end_row();
     };
     int first_step = 1;
@@ -151,7 +261,7 @@ class SolidProblem final : public run::Problem {
       log::info("continuing after step {} (t = {:g} s)", first_step - 1, times.back());
     } else {
       record(0, 0.0, 0);
-      if (parameters().write_vtk) solid_.write_vtk(output, 0.0);
+      if (parameters().write_vtk) write_vtk(output, 0.0);
     }
     const auto checkpoint = [&](int step, double t) {
       ScopedTimer timer(output.timers(), "checkpoint");
@@ -182,8 +292,7 @@ class SolidProblem final : public run::Problem {
           step, t,
           fmt::format("newton {} (|R| {:.2e} -> {:.2e}), ksp {}", report.newton_iterations,
                       report.history.front(), report.norm(), report.linear_iterations));
-      if (parameters().write_vtk && step % parameters().vtk_interval == 0)
-        solid_.write_vtk(output, t);
+      if (parameters().write_vtk && step % parameters().vtk_interval == 0) write_vtk(output, t);
       if (parameters().checkpoint_interval > 0 && step % parameters().checkpoint_interval == 0)
         checkpoint(step, t);
     }
@@ -214,13 +323,18 @@ class SolidProblem final : public run::Problem {
     log::info("total energy: initial {:.10e}, max |E - E0| / max(kinetic + strain) = {:.3e}",
               initial_energy, drift);
     write_mesh_figures(benchmark);
+    if (contact_) write_contact_figures(benchmark);
     benchmark["time_step"] = time.step;
     auto& iterations = output.summary()["iterations"];
     iterations["newton"] = total_newton;
     iterations["linear"] = total_linear;
   }
 
+  contact::ContactParameters contact_parameters_;
+  contact::HertzParameters hertz_;
+  contact::PatchTestParameters patch_test_;
   SolidModel solid_;
+  std::unique_ptr<contact::ContactHook> contact_;  ///< null without a `contact:` section
   const run::CheckpointReader* restart_ = nullptr;
 };
 

@@ -264,11 +264,10 @@ void MasterExchange<dim>::refresh(const mesh::Mesh& master) {
 
 template <int dim>
 void BoxGrid<dim>::build(std::span<const Box<dim>> boxes) {
-  boxes_.assign(boxes.begin(), boxes.end());
   Box<dim> all = Box<dim>::empty();
   Point<dim> mean_extent{};
   std::size_t n_boxes = 0;
-  for (const Box<dim>& b : boxes_) {
+  for (const Box<dim>& b : boxes) {
     if (b.is_empty()) continue;
     all.include(b);
     for (int k = 0; k < dim; ++k) mean_extent[k] += b.upper[k] - b.lower[k];
@@ -277,13 +276,17 @@ void BoxGrid<dim>::build(std::span<const Box<dim>> boxes) {
   counts_.fill(1);
   origin_ = all.lower;
   inverse_size_.fill(0.0);
+  bin_size_.fill(0.0);
+  reach_.fill(0.0);
   if (n_boxes > 0) {
-    // bin size: the mean extent (at least 1e-9 of the domain, so flat sets stay finite)
+    // bin size: 1.5 mean extents, so that nearly every box of an even mesh is small (at
+    // least 1e-9 of the domain, so flat sets stay finite)
     std::array<double, dim> n_bins{};
     double total = 1.0;
     for (int k = 0; k < dim; ++k) {
       const double extent = all.upper[k] - all.lower[k];
-      const double size = std::max(mean_extent[k] / static_cast<double>(n_boxes), 1e-9 * extent);
+      const double size =
+          std::max(1.5 * mean_extent[k] / static_cast<double>(n_boxes), 1e-9 * extent);
       n_bins[k] = extent > 0.0 ? std::max(1.0, std::floor(extent / size)) : 1.0;
       total *= n_bins[k];
     }
@@ -296,12 +299,68 @@ void BoxGrid<dim>::build(std::span<const Box<dim>> boxes) {
       counts_[k] = static_cast<int>(n_bins[k]);
       const double extent = all.upper[k] - all.lower[k];
       inverse_size_[k] = extent > 0.0 ? counts_[k] / extent : 0.0;
+      // a bin's width, rounded down a little: a box this small spans at most two bins
+      bin_size_[k] = extent > 0.0 ? extent / counts_[k] * (1.0 - 1e-12) : 0.0;
+      // a small box overlapping a query has lower ≥ query.lower − bin_size_ in exact
+      // arithmetic; the slack covers the rounding of the differences
+      const double magnitude = std::max(std::fabs(all.lower[k]), std::fabs(all.upper[k]));
+      reach_[k] =
+          bin_size_[k] * (1.0 + 1e-9) + 8.0 * std::numeric_limits<double>::epsilon() * magnitude;
     }
   }
   std::size_t n_total = 1;
   for (int k = 0; k < dim; ++k) n_total *= static_cast<std::size_t>(counts_[k]);
-  bin_offsets_.assign(n_total + 1, 0);
-  // Two passes over each box's bin range: count, then fill.
+  const auto bin_of = [&](const Point<dim>& x) {
+    int index = 0;
+    for (int k = dim - 1; k >= 0; --k) index = index * counts_[k] + bin_coordinate(x[k], k);
+    return index;
+  };
+  const auto is_small = [&](const Box<dim>& b) {
+    for (int k = 0; k < dim; ++k)
+      if (!(b.upper[k] - b.lower[k] <= bin_size_[k])) return false;
+    return true;
+  };
+
+  // Small boxes: counting sort by the bin of the lower corner.
+  small_offsets_.assign(n_total + 1, 0);
+  std::size_t n_small = 0, n_large = 0;
+  for (const Box<dim>& b : boxes) {
+    if (b.is_empty()) continue;
+    if (is_small(b)) {
+      ++small_offsets_[static_cast<std::size_t>(bin_of(b.lower)) + 1];
+      ++n_small;
+    } else {
+      ++n_large;
+    }
+  }
+  std::partial_sum(small_offsets_.begin(), small_offsets_.end(), small_offsets_.begin());
+  small_boxes_.resize(n_small);
+  small_ids_.resize(n_small);
+  large_boxes_.clear();
+  large_ids_.clear();
+  large_boxes_.reserve(n_large);
+  large_ids_.reserve(n_large);
+  {
+    std::vector<int> fill(small_offsets_.begin(), small_offsets_.end() - 1);
+    for (std::size_t i = 0; i < boxes.size(); ++i) {
+      const Box<dim>& b = boxes[i];
+      if (b.is_empty()) continue;
+      if (is_small(b)) {
+        const int at = fill[static_cast<std::size_t>(bin_of(b.lower))]++;
+        small_boxes_[static_cast<std::size_t>(at)] = b;
+        small_ids_[static_cast<std::size_t>(at)] = static_cast<int>(i);
+      } else {
+        large_boxes_.push_back(b);
+        large_ids_.push_back(static_cast<int>(i));
+      }
+    }
+  }
+
+  // Large boxes: listed in every bin they overlap (two passes: count, then fill).
+  large_offsets_.clear();
+  large_entries_.clear();
+  if (n_large == 0) return;
+  large_offsets_.assign(n_total + 1, 0);
   auto for_each_bin = [&](const Box<dim>& b, auto&& action) {
     std::array<int, dim> lo, hi, bin;
     for (int k = 0; k < dim; ++k) {
@@ -322,15 +381,14 @@ void BoxGrid<dim>::build(std::span<const Box<dim>> boxes) {
       ++bin[k];
     }
   };
-  for (const Box<dim>& b : boxes_)
-    if (!b.is_empty()) for_each_bin(b, [&](int index) { ++bin_offsets_[index + 1]; });
-  std::partial_sum(bin_offsets_.begin(), bin_offsets_.end(), bin_offsets_.begin());
-  bin_entries_.resize(static_cast<std::size_t>(bin_offsets_.back()));
-  std::vector<int> fill(bin_offsets_.begin(), bin_offsets_.end() - 1);
-  for (std::size_t i = 0; i < boxes_.size(); ++i)
-    if (!boxes_[i].is_empty())
-      for_each_bin(boxes_[i],
-                   [&](int index) { bin_entries_[fill[index]++] = static_cast<int>(i); });
+  for (const Box<dim>& b : large_boxes_)
+    for_each_bin(b, [&](int index) { ++large_offsets_[index + 1]; });
+  std::partial_sum(large_offsets_.begin(), large_offsets_.end(), large_offsets_.begin());
+  large_entries_.resize(static_cast<std::size_t>(large_offsets_.back()));
+  std::vector<int> fill(large_offsets_.begin(), large_offsets_.end() - 1);
+  for (std::size_t i = 0; i < large_boxes_.size(); ++i)
+    for_each_bin(large_boxes_[i],
+                 [&](int index) { large_entries_[fill[index]++] = static_cast<int>(i); });
 }
 
 template <int dim>

@@ -185,23 +185,29 @@ class MasterExchange {
 // Stage 2: local acceleration structure and pair list
 // ------------------------------------------------------------------------------------------
 
-/// A uniform grid of bins over a set of boxes; each box is listed in every bin it overlaps.
-/// Queries need no scratch state (a box met in several bins is reported from one bin only:
-/// the first bin of the overlap of its bin range with the query's), so they are const and
-/// thread-safe.
+/// A uniform grid of bins over a set of boxes. A box no larger than a bin on every axis (a
+/// "small" box: nearly all of them in a mesh of even size) is stored once, in the bin of its
+/// lower corner, and the small boxes are kept sorted by bin, so a query scans contiguous
+/// memory: the boxes that can reach the query have their lower corner in the bins from
+/// (query.lower − bin size) to query.upper, and a row of bins along x is one run of boxes.
+/// A larger box is listed in every bin it overlaps and reported from the first bin of the
+/// overlap of its bin range with the query's only. Queries need no scratch state, so they are
+/// const and thread-safe.
 template <int dim>
 class BoxGrid {
  public:
-  /// Bins `boxes` (empty boxes are left out). The bin size is the mean box extent per axis,
-  /// enlarged when needed to keep at most about 2 bins per box. Linear time.
+  /// Bins `boxes` (empty boxes are left out). The bin size is 1.5 times the mean box extent
+  /// per axis, enlarged when needed to keep at most about 2 bins per box. Linear time.
   void build(std::span<const Box<dim>> boxes);
   /// Calls visit(i) once for each box i that overlaps `query` (closed boxes).
   template <class Visit>
   void query(const Box<dim>& query, Visit&& visit) const;
-  std::size_t n_bins() const { return bin_offsets_.empty() ? 0 : bin_offsets_.size() - 1; }
+  std::size_t n_bins() const { return small_offsets_.empty() ? 0 : small_offsets_.size() - 1; }
   std::size_t memory_bytes() const {
-    return boxes_.capacity() * sizeof(Box<dim>) + bin_offsets_.capacity() * sizeof(int) +
-           bin_entries_.capacity() * sizeof(int);
+    return (small_boxes_.capacity() + large_boxes_.capacity()) * sizeof(Box<dim>) +
+           (small_offsets_.capacity() + small_ids_.capacity() + large_offsets_.capacity() +
+            large_entries_.capacity() + large_ids_.capacity()) *
+               sizeof(int);
   }
 
  private:
@@ -213,10 +219,18 @@ class BoxGrid {
 
   Point<dim> origin_{};
   Point<dim> inverse_size_{};
+  Point<dim> bin_size_{};  ///< a small box's extent is at most this on every axis
+  Point<dim> reach_{};     ///< bin_size_ plus round-off slack, for the small-box queries
   std::array<int, dim> counts_{};
-  std::vector<Box<dim>> boxes_;
-  std::vector<int> bin_offsets_;
-  std::vector<int> bin_entries_;
+  // small boxes, sorted by the bin of their lower corner
+  std::vector<int> small_offsets_;  ///< per bin + 1, into small_boxes_ / small_ids_
+  std::vector<Box<dim>> small_boxes_;
+  std::vector<int> small_ids_;
+  // large boxes, listed in every bin they overlap
+  std::vector<int> large_offsets_;  ///< per bin + 1 (empty when there are no large boxes)
+  std::vector<int> large_entries_;  ///< indices into large_boxes_ / large_ids_
+  std::vector<Box<dim>> large_boxes_;
+  std::vector<int> large_ids_;
 };
 
 /// Options of the pair search.
@@ -306,25 +320,48 @@ class PairSearch {
 template <int dim>
 template <class Visit>
 void BoxGrid<dim>::query(const Box<dim>& query, Visit&& visit) const {
-  if (boxes_.empty() || query.is_empty()) return;
+  if (small_offsets_.empty() || query.is_empty()) return;
   std::array<int, dim> lo, hi;
+  // Small boxes: lower corner in [query.lower − bin size, query.upper]; rows along x are
+  // contiguous runs of small_boxes_.
   for (int k = 0; k < dim; ++k) {
-    lo[k] = bin_coordinate(query.lower[k], k);
+    lo[k] = bin_coordinate(query.lower[k] - reach_[k], k);
     hi[k] = bin_coordinate(query.upper[k], k);
   }
   std::array<int, dim> bin = lo;
   while (true) {
     int index = 0;
+    for (int k = dim - 1; k >= 1; --k) index = index * counts_[k] + bin[k];
+    index *= counts_[0];
+    const int end = small_offsets_[index + hi[0] + 1];
+    for (int e = small_offsets_[index + lo[0]]; e < end; ++e)
+      if (small_boxes_[e].overlaps(query)) visit(small_ids_[e]);
+    int k = 1;
+    while (k < dim && bin[k] == hi[k]) {
+      bin[k] = lo[k];
+      ++k;
+    }
+    if (k == dim) break;
+    ++bin[k];
+  }
+  if (large_offsets_.empty()) return;
+  for (int k = 0; k < dim; ++k) {
+    lo[k] = bin_coordinate(query.lower[k], k);
+    hi[k] = bin_coordinate(query.upper[k], k);
+  }
+  bin = lo;
+  while (true) {
+    int index = 0;
     for (int k = dim - 1; k >= 0; --k) index = index * counts_[k] + bin[k];
-    for (int e = bin_offsets_[index]; e < bin_offsets_[index + 1]; ++e) {
-      const int i = bin_entries_[e];
-      const Box<dim>& box = boxes_[i];
+    for (int e = large_offsets_[index]; e < large_offsets_[index + 1]; ++e) {
+      const int i = large_entries_[e];
+      const Box<dim>& box = large_boxes_[i];
       if (!box.overlaps(query)) continue;
       // report from the first bin of the overlap of the two bin ranges only
       bool first = true;
       for (int k = 0; k < dim && first; ++k)
         first = bin[k] == std::max(lo[k], bin_coordinate(box.lower[k], k));
-      if (first) visit(i);
+      if (first) visit(large_ids_[i]);
     }
     int k = 0;
     while (k < dim && bin[k] == hi[k]) {

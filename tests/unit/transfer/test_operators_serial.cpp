@@ -197,6 +197,38 @@ TEST(TransferSearch, GridQueryMatchesBruteForce) {
   }
 }
 
+TEST(TransferSearch, GridQueryMatchesBruteForceWithMixedSizes) {
+  // Boxes of a fine mesh (small: stored once, by lower corner), a few large ones (listed in
+  // every bin they overlap), flat and empty ones; queries of every size, touching included.
+  const Mesh master = rotated(box(0.1, 0.2, 0.05, 0.9, 0.7, 0.8, 6, 5, 7), 0.4, {1, 2, 3});
+  std::vector<Box<3>> boxes;
+  for (int c = 0; c < master.n_cells(); ++c)
+    boxes.push_back(Box<3>::of(cell_simplex<3>(master, c)));
+  boxes.push_back(Box<3>{{0.0, 0.0, 0.0}, {0.6, 0.3, 0.9}});
+  boxes.push_back(Box<3>{{0.5, 0.1, 0.2}, {0.55, 0.9, 0.25}});
+  boxes.push_back(Box<3>{{0.3, 0.3, 0.3}, {0.3, 0.3, 0.7}});  // flat
+  boxes.push_back(Box<3>::empty());
+  boxes.push_back(Box<3>{{-0.2, 0.4, 0.4}, {1.2, 0.45, 0.45}});
+  BoxGrid<3> grid;
+  grid.build(boxes);
+  std::vector<Box<3>> queries;
+  const Mesh slave = box(0, 0, 0, 1, 1, 1, 9, 7, 8);
+  for (int c = 0; c < slave.n_cells(); ++c)
+    queries.push_back(Box<3>::of(cell_simplex<3>(slave, c)));
+  queries.push_back(Box<3>{{0.2, 0.2, 0.2}, {0.8, 0.8, 0.8}});
+  queries.push_back(Box<3>{{0.6, 0.3, 0.9}, {0.7, 0.4, 1.0}});  // touches a corner
+  queries.push_back(Box<3>{{-1, -1, -1}, {2, 2, 2}});
+  queries.push_back(boxes[7]);
+  for (std::size_t q = 0; q < queries.size(); ++q) {
+    std::vector<int> found, expected;
+    grid.query(queries[q], [&](int i) { found.push_back(i); });
+    for (int i = 0; i < static_cast<int>(boxes.size()); ++i)
+      if (!boxes[i].is_empty() && boxes[i].overlaps(queries[q])) expected.push_back(i);
+    std::sort(found.begin(), found.end());
+    ASSERT_EQ(found, expected) << "query " << q;  // each once
+  }
+}
+
 TEST(TransferSearch, ExchangeSendsWhatOverlaps) {
   const Mesh master = box(0.5, 0.5, 0.5, 1.5, 1.5, 1.5, 3, 3, 3);
   MasterExchange<3> exchange;

@@ -1,0 +1,383 @@
+// The contact transformation of the solid's Newton system (contact_constraints.hpp): surfaces
+// gathered on every rank, mortar operators and multipliers at each residual, the active set,
+// and the row operator P and gap rows G assembled row by row on their owning ranks.
+#include "coapt/contact/contact_constraints.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <unordered_map>
+
+#include "coapt/core/error.hpp"
+
+namespace coapt::contact {
+
+namespace {
+
+/// A sparse matrix of the dof layout [first, end) on each rank from owned-row triplets.
+OwnedMat matrix_from_triplets(MPI_Comm comm, PetscInt n_local, std::vector<PetscInt>& rows,
+                              std::vector<PetscInt>& columns, const std::vector<double>& values) {
+  OwnedMat matrix;
+  COAPT_PETSC_CHECK(MatCreate(comm, matrix.out()));
+  COAPT_PETSC_CHECK(MatSetSizes(matrix, n_local, n_local, PETSC_DETERMINE, PETSC_DETERMINE));
+  // MPIAIJ on every communicator size, like the solid's P1Matrix (products need one type).
+  COAPT_PETSC_CHECK(MatSetType(matrix, MATMPIAIJ));
+  COAPT_PETSC_CHECK(MatSetPreallocationCOO(matrix, static_cast<PetscCount>(rows.size()),
+                                           rows.data(), columns.data()));
+  COAPT_PETSC_CHECK(MatSetValuesCOO(matrix, values.data(), INSERT_VALUES));
+  return matrix;
+}
+
+}  // namespace
+
+ContactConstraints::ContactConstraints(const ContactParameters& parameters, const mesh::Mesh& mesh,
+                                       std::span<const PetscInt> dirichlet_dofs, Vec layout)
+    : parameters_(parameters),
+      mesh_(mesh),
+      dim_(mesh.dim),
+      dirichlet_(dirichlet_dofs.begin(), dirichlet_dofs.end()) {
+  std::sort(dirichlet_.begin(), dirichlet_.end());
+  first_dof_ = mesh.vertex_offset * dim_;
+  end_dof_ = first_dof_ + static_cast<PetscInt>(mesh.n_owned_vertices) * dim_;
+  complementarity_constant_ = parameters.complementarity_constant;
+  COAPT_PETSC_CHECK(VecDuplicate(layout, dirichlet_marker_.out()));
+  COAPT_PETSC_CHECK(VecDuplicate(layout, work_.out()));
+  COAPT_PETSC_CHECK(VecSet(dirichlet_marker_, 0.0));
+  for (PetscInt dof : dirichlet_)
+    COAPT_PETSC_CHECK(VecSetValue(dirichlet_marker_, dof, 1.0, INSERT_VALUES));
+  COAPT_PETSC_CHECK(VecAssemblyBegin(dirichlet_marker_));
+  COAPT_PETSC_CHECK(VecAssemblyEnd(dirichlet_marker_));
+
+  const auto boundary_tag = [&](const std::string& name, const std::string& where) {
+    const auto* group = mesh.find_group(name);
+    if (!group || group->dim != dim_ - 1) {
+      std::string names;
+      for (const auto& g : mesh.groups)
+        if (g.dim == dim_ - 1) names += (names.empty() ? "" : ", ") + g.name;
+      throw InputError(fmt::format("{}: no boundary group '{}' in {} (it has: {})", where, name,
+                                   mesh.source, names.empty() ? "none" : names));
+    }
+    return group->tag;
+  };
+  std::vector<PetscInt> slave_vertices;
+  for (const auto& pair : parameters.pairs) {
+    const int slave_tag = boundary_tag(pair.slave, pair.where);
+    const int master_tag = boundary_tag(pair.master, pair.where);
+    PairState state;
+    state.slave = gather_surface(mesh, std::span<const int>(&slave_tag, 1), pair.slave);
+    state.master = gather_surface(mesh, std::span<const int>(&master_tag, 1), pair.master);
+    if (state.slave.n_facets() == 0 || state.master.n_facets() == 0)
+      throw InputError(fmt::format("{}: boundary group '{}' has no facets in {}", pair.where,
+                                   state.slave.n_facets() == 0 ? pair.slave : pair.master,
+                                   mesh.source));
+    slave_vertices.insert(slave_vertices.end(), state.slave.global_vertex.begin(),
+                          state.slave.global_vertex.end());
+    slave_gathers_.push_back(std::make_unique<SurfaceGather>(state.slave, layout));
+    master_gathers_.push_back(std::make_unique<SurfaceGather>(state.master, layout));
+    std::vector<double> marker;
+    slave_gathers_.back()->gather(dirichlet_marker_, marker);
+    state.dirichlet.assign(marker.size(), 0);
+    for (std::size_t k = 0; k < marker.size(); ++k) state.dirichlet[k] = marker[k] > 0.5;
+    double size = 0;
+    for (int f = 0; f < state.slave.n_facets(); ++f) {
+      const auto a = facet_area_normal(state.slave, state.slave.reference, f);
+      const double measure = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+      size += dim_ == 2 ? measure : std::sqrt(4.0 * measure / std::sqrt(3.0));
+    }
+    reference_sizes_.push_back(size / state.slave.n_facets());
+    const std::size_t n = static_cast<std::size_t>(state.slave.n_nodes());
+    state.pressure.assign(n, 0.0);
+    state.active.assign(n, 0);
+    pairs_.push_back(std::move(state));
+  }
+  std::sort(slave_vertices.begin(), slave_vertices.end());
+  if (std::adjacent_find(slave_vertices.begin(), slave_vertices.end()) != slave_vertices.end())
+    throw InputError(
+        fmt::format("{}: pairs: a node belongs to the slave surfaces of two pairs "
+                    "(give each slave surface one pair)",
+                    parameters.where));
+}
+
+ContactConstraints::~ContactConstraints() = default;
+
+void ContactConstraints::update(Vec u, Vec residual) {
+  ContactStatus status;
+  status.complementarity_constant = complementarity_constant_;
+  status.min_active_pressure = 0.0;
+  bool first_active = true;
+  std::vector<double> displacement, force;
+  for (std::size_t p = 0; p < pairs_.size(); ++p) {
+    auto& pair = pairs_[p];
+    const auto position = [&](const Surface& s, const SurfaceGather& gather,
+                              std::vector<double>& x) {
+      gather.gather(u, displacement);
+      x = s.reference;
+      for (std::size_t k = 0; k < x.size(); ++k) x[k] += displacement[k];
+    };
+    position(pair.slave, *slave_gathers_[p], pair.slave_x);
+    position(pair.master, *master_gathers_[p], pair.master_x);
+    slave_gathers_[p]->gather(residual, force);
+    MortarOptions options;
+    options.search_distance = parameters_.search_distance > 0.0 ? parameters_.search_distance
+                                                                : 10.0 * reference_sizes_[p];
+    options.coverage_threshold = parameters_.coverage_threshold;
+    options.boundary_modification = parameters_.boundary_modification;
+    options.fixed_components = pair.dirichlet;
+    pair.mortar = assemble_mortar(pair.slave, pair.slave_x, pair.master, pair.master_x, options);
+    const double tolerance = parameters_.relative_gap_tolerance * reference_sizes_[p];
+    status.gap_tolerance = std::max(status.gap_tolerance, tolerance);
+    const auto& m = pair.mortar;
+    std::vector<double> row_sum(static_cast<std::size_t>(pair.slave.n_nodes()), 0.0);
+    for (const auto& e : m.slave_coupling) row_sum[e.row] += e.value;  // ∫_Γc Φ̃_j
+    for (int j = 0; j < pair.slave.n_nodes(); ++j) {
+      const bool was_active = pair.active[j] != 0;
+      pair.pressure[j] = 0.0;
+      pair.active[j] = 0;
+      if (!m.constrained(j)) {
+        status.changes += was_active ? 1 : 0;
+        continue;
+      }
+      ++status.constrained;
+      double normal_force = 0.0;  // n_j · R_j over the free components
+      for (int i = 0; i < dim_; ++i) {
+        const std::size_t k = static_cast<std::size_t>(j) * dim_ + i;
+        if (!pair.dirichlet[k]) normal_force += m.normals[k] * force[k];
+      }
+      const double pressure = -normal_force / m.dual_mass[j];
+      const double gap = m.gap(j);
+      const bool active = complementarity_constant_ > 0.0
+                              ? pressure - complementarity_constant_ * (gap - tolerance) > 0.0
+                              : (gap <= tolerance || pressure > 0.0);
+      pair.pressure[j] = pressure;
+      pair.active[j] = active;
+      status.changes += active != was_active ? 1 : 0;
+      status.max_penetration = std::max(status.max_penetration, -gap);
+      status.max_complementarity = std::max(status.max_complementarity, std::abs(pressure * gap));
+      if (active) {
+        ++status.active;
+        status.max_pressure = std::max(status.max_pressure, pressure);
+        status.min_active_pressure =
+            first_active ? pressure : std::min(status.min_active_pressure, pressure);
+        first_active = false;
+        status.total_force += row_sum[j] * pressure;
+        status.contact_measure += row_sum[j];
+      } else {
+        status.max_open_pressure = std::max(status.max_open_pressure, std::abs(pressure));
+      }
+    }
+  }
+  status_ = status;
+  build_row_operator();
+  if (status_.active == 0) return;
+  // R ← P R − c n g̃ on the active rows.
+  COAPT_PETSC_CHECK(MatMult(row_operator_, residual, work_));
+  for (const auto& pair : pairs_)
+    for (int j = 0; j < pair.slave.n_nodes(); ++j) {
+      if (!pair.active[j]) continue;
+      for (int i = 0; i < dim_; ++i) {
+        const PetscInt dof = pair.slave.global_vertex[j] * dim_ + i;
+        if (dof < first_dof_ || dof >= end_dof_ ||
+            pair.dirichlet[static_cast<std::size_t>(j) * dim_ + i])
+          continue;
+        const double value = -complementarity_constant_ *
+                             pair.mortar.normals[static_cast<std::size_t>(j) * dim_ + i] *
+                             pair.mortar.weighted_gap[j];
+        COAPT_PETSC_CHECK(VecSetValue(work_, dof, value, ADD_VALUES));
+      }
+    }
+  COAPT_PETSC_CHECK(VecAssemblyBegin(work_));
+  COAPT_PETSC_CHECK(VecAssemblyEnd(work_));
+  COAPT_PETSC_CHECK(VecCopy(work_, residual));
+}
+
+void ContactConstraints::build_row_operator() {
+  row_operator_.reset();
+  if (status_.active == 0) return;
+  // Normals of the active slave nodes by global vertex (for S_k on rows that are active too).
+  std::unordered_map<PetscInt, const double*> active_normal;
+  for (const auto& pair : pairs_)
+    for (int j = 0; j < pair.slave.n_nodes(); ++j)
+      if (pair.active[j])
+        active_normal[pair.slave.global_vertex[j]] =
+            pair.mortar.normals.data() + static_cast<std::size_t>(j) * dim_;
+  const auto prescribed = [&](PetscInt dof) {
+    return std::binary_search(dirichlet_.begin(), dirichlet_.end(), dof);
+  };
+  std::vector<PetscInt> rows, columns;
+  std::vector<double> values;
+  for (PetscInt dof = first_dof_; dof < end_dof_; ++dof) {
+    rows.push_back(dof);
+    columns.push_back(dof);
+    values.push_back(1.0);
+  }
+  // Adds coefficient × S_row n nᵀ into block (row vertex, column vertex), owned free rows only.
+  const auto add_block = [&](PetscInt row_vertex, PetscInt column_vertex, const double* n,
+                             double coefficient, const std::vector<char>& column_dirichlet,
+                             int column_node) {
+    const auto found = active_normal.find(row_vertex);
+    const double* s = found == active_normal.end() ? nullptr : found->second;
+    for (int a = 0; a < dim_; ++a) {
+      const PetscInt row = row_vertex * dim_ + a;
+      if (row < first_dof_ || row >= end_dof_ || prescribed(row)) continue;
+      // (S n)_a = n_a − s_a (s · n) when the row node is active.
+      double sn = n[a];
+      if (s) {
+        double sdotn = 0.0;
+        for (int i = 0; i < dim_; ++i) sdotn += s[i] * n[i];
+        sn -= s[a] * sdotn;
+      }
+      if (sn == 0.0) continue;
+      for (int b = 0; b < dim_; ++b) {
+        if (column_dirichlet[static_cast<std::size_t>(column_node) * dim_ + b]) continue;
+        rows.push_back(row);
+        columns.push_back(column_vertex * dim_ + b);
+        values.push_back(coefficient * sn * n[b]);
+      }
+    }
+  };
+  for (const auto& pair : pairs_) {
+    const auto& m = pair.mortar;
+    for (int j = 0; j < pair.slave.n_nodes(); ++j) {
+      if (!pair.active[j]) continue;
+      const double* n = m.normals.data() + static_cast<std::size_t>(j) * dim_;
+      const PetscInt vertex = pair.slave.global_vertex[j];
+      // −n nᵀ on the node's own rows (S_j applied to the identity row block: I − n nᵀ).
+      for (int a = 0; a < dim_; ++a) {
+        const PetscInt row = vertex * dim_ + a;
+        if (row < first_dof_ || row >= end_dof_ || prescribed(row)) continue;
+        for (int b = 0; b < dim_; ++b) {
+          if (pair.dirichlet[static_cast<std::size_t>(j) * dim_ + b]) continue;
+          rows.push_back(row);
+          columns.push_back(vertex * dim_ + b);
+          values.push_back(-n[a] * n[b]);
+        }
+      }
+    }
+    // Elimination of λ_j from the other rows: −B_jk / D_jj (S_k n_j n_jᵀ) in block (k, j).
+    for (const auto& e : m.master_coupling)
+      if (pair.active[e.row])
+        add_block(pair.master.global_vertex[e.column], pair.slave.global_vertex[e.row],
+                  m.normals.data() + static_cast<std::size_t>(e.row) * dim_,
+                  e.value / m.dual_mass[e.row], pair.dirichlet, e.row);
+    for (const auto& e : m.slave_coupling)
+      if (pair.active[e.row] && e.column != e.row)
+        add_block(pair.slave.global_vertex[e.column], pair.slave.global_vertex[e.row],
+                  m.normals.data() + static_cast<std::size_t>(e.row) * dim_,
+                  -e.value / m.dual_mass[e.row], pair.dirichlet, e.row);
+  }
+  row_operator_ = matrix_from_triplets(mesh_.comm, end_dof_ - first_dof_, rows, columns, values);
+}
+
+Mat ContactConstraints::transform(Mat K, Vec rhs) {
+  if (status_.active == 0) return K;
+  if (!(complementarity_constant_ > 0.0)) {
+    // c from the stiffness: mean K_ii over the free dofs of constrained slave nodes over the
+    // mean D_jj of those nodes, so the gap rows weigh like the equilibrium rows.
+    OwnedVec diagonal;
+    COAPT_PETSC_CHECK(VecDuplicate(work_, diagonal.out()));
+    COAPT_PETSC_CHECK(MatGetDiagonal(K, diagonal));
+    double stiffness = 0.0, dual = 0.0;
+    long n_dofs = 0, n_nodes = 0;
+    std::vector<double> values;
+    for (std::size_t p = 0; p < pairs_.size(); ++p) {
+      slave_gathers_[p]->gather(diagonal, values);
+      const auto& pair = pairs_[p];
+      for (int j = 0; j < pair.slave.n_nodes(); ++j) {
+        if (!pair.mortar.constrained(j)) continue;
+        dual += pair.mortar.dual_mass[j];
+        ++n_nodes;
+        for (int i = 0; i < dim_; ++i) {
+          const std::size_t k = static_cast<std::size_t>(j) * dim_ + i;
+          if (pair.dirichlet[k]) continue;
+          stiffness += std::abs(values[k]);
+          ++n_dofs;
+        }
+      }
+    }
+    if (n_dofs > 0 && dual > 0.0)
+      complementarity_constant_ = (stiffness / n_dofs) / (dual / n_nodes);
+    status_.complementarity_constant = complementarity_constant_;
+  }
+  // G = c Σ_{j∈A} E_j n_j n_jᵀ B_j on owned free rows.
+  std::vector<PetscInt> rows, columns;
+  std::vector<double> values;
+  const double c = complementarity_constant_;
+  const auto prescribed = [&](PetscInt dof) {
+    return std::binary_search(dirichlet_.begin(), dirichlet_.end(), dof);
+  };
+  for (const auto& pair : pairs_) {
+    const auto& m = pair.mortar;
+    const auto add_row_block = [&](const MortarEntry& e, PetscInt column_vertex, double sign) {
+      const double* n = m.normals.data() + static_cast<std::size_t>(e.row) * dim_;
+      const PetscInt vertex = pair.slave.global_vertex[e.row];
+      for (int a = 0; a < dim_; ++a) {
+        const PetscInt row = vertex * dim_ + a;
+        if (row < first_dof_ || row >= end_dof_ || prescribed(row) || n[a] == 0.0) continue;
+        for (int b = 0; b < dim_; ++b) {
+          rows.push_back(row);
+          columns.push_back(column_vertex * dim_ + b);
+          values.push_back(sign * c * n[a] * n[b] * e.value);
+        }
+      }
+    };
+    for (const auto& e : m.slave_coupling)
+      if (pair.active[e.row]) add_row_block(e, pair.slave.global_vertex[e.column], 1.0);
+    for (const auto& e : m.master_coupling)
+      if (pair.active[e.row]) add_row_block(e, pair.master.global_vertex[e.column], -1.0);
+  }
+  gap_rows_ = matrix_from_triplets(mesh_.comm, end_dof_ - first_dof_, rows, columns, values);
+  contact_matrix_.reset();
+  COAPT_PETSC_CHECK(
+      MatMatMult(row_operator_, K, MAT_INITIAL_MATRIX, PETSC_DEFAULT, contact_matrix_.out()));
+  COAPT_PETSC_CHECK(MatAXPY(contact_matrix_, 1.0, gap_rows_, DIFFERENT_NONZERO_PATTERN));
+  // rhs ← P rhs + c n g̃ on the active rows.
+  COAPT_PETSC_CHECK(MatMult(row_operator_, rhs, work_));
+  for (const auto& pair : pairs_)
+    for (int j = 0; j < pair.slave.n_nodes(); ++j) {
+      if (!pair.active[j]) continue;
+      for (int i = 0; i < dim_; ++i) {
+        const PetscInt dof = pair.slave.global_vertex[j] * dim_ + i;
+        if (dof < first_dof_ || dof >= end_dof_ || prescribed(dof)) continue;
+        COAPT_PETSC_CHECK(
+            VecSetValue(work_, dof,
+                        c * pair.mortar.normals[static_cast<std::size_t>(j) * dim_ + i] *
+                            pair.mortar.weighted_gap[j],
+                        ADD_VALUES));
+      }
+    }
+  COAPT_PETSC_CHECK(VecAssemblyBegin(work_));
+  COAPT_PETSC_CHECK(VecAssemblyEnd(work_));
+  COAPT_PETSC_CHECK(VecCopy(work_, rhs));
+  return contact_matrix_;
+}
+
+void ContactConstraints::vertex_fields(std::vector<double>& pressure, std::vector<double>& gap,
+                                       std::vector<double>& active) const {
+  const std::size_t n = static_cast<std::size_t>(mesh_.n_vertices());
+  pressure.assign(n, 0.0);
+  gap.assign(n, 0.0);
+  active.assign(n, 0.0);
+  std::unordered_map<PetscInt, int> local;
+  for (int v = 0; v < mesh_.n_vertices(); ++v) local.emplace(mesh_.global_vertex[v], v);
+  for (const auto& pair : pairs_)
+    for (int j = 0; j < pair.slave.n_nodes(); ++j) {
+      const auto found = local.find(pair.slave.global_vertex[j]);
+      if (found == local.end()) continue;
+      pressure[found->second] = pair.pressure[j];
+      gap[found->second] = pair.mortar.multiplier.empty() ? 0.0 : pair.mortar.gap(j);
+      active[found->second] = pair.active[j] ? 1.0 : 0.0;
+    }
+}
+
+std::string ContactConstraints::describe() const {
+  std::string text;
+  for (std::size_t p = 0; p < pairs_.size(); ++p)
+    text += fmt::format("{}slave '{}' ({} facets) / master '{}' ({} facets)", p ? "; " : "",
+                        pairs_[p].slave.name, pairs_[p].slave.n_facets(), pairs_[p].master.name,
+                        pairs_[p].master.n_facets());
+  return text;
+}
+
+}  // namespace coapt::contact

@@ -1,0 +1,183 @@
+// The contact Newton hook of the solid, its output, and the Hertz comparison.
+#include "coapt/contact/solid_contact.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "coapt/core/error.hpp"
+#include "coapt/core/log.hpp"
+
+namespace coapt::contact {
+
+using config::Bounds;
+
+HertzParameters HertzParameters::read(const config::Section& root) {
+  HertzParameters h;
+  if (!root.has("hertz")) return h;
+  const auto section =
+      root.section("hertz", "analytic Hertz reference for the benchmark (Johnson 1985)");
+  h.enabled = true;
+  h.sphere =
+      section.choice("geometry", "cylinder", {"cylinder", "sphere"},
+                     {"", "cylinder: 2D line contact, sphere: 3D point contact"}) == "sphere";
+  h.radius = section.require<double>("radius", {"m", "radius R of the body", Bounds::positive()});
+  h.load = section.require<double>(
+      "load", {"N/m or N", "load P on the whole body (per unit length for a cylinder)",
+               Bounds::positive()});
+  h.young_modulus = section.require<double>(
+      "young_modulus",
+      {"Pa", "Young's modulus of the body (the flat is rigid)", Bounds::positive()});
+  h.poisson_ratio = section.require<double>(
+      "poisson_ratio", {"", "Poisson's ratio of the body", Bounds::open(-1.0, 0.5)});
+  return h;
+}
+
+PatchTestParameters PatchTestParameters::read(const config::Section& root) {
+  PatchTestParameters p;
+  if (!root.has("patch_test")) return p;
+  const auto section = root.section("patch_test", "contact patch test reference");
+  p.enabled = true;
+  p.force = section.require<double>(
+      "force",
+      {"N/m or N", "the total normal load the contact surface must transmit", Bounds::positive()});
+  return p;
+}
+
+double pressure_error(const ContactConstraints& constraints, double force) {
+  const double pressure = force / constraints.status().contact_measure;
+  double error = 0.0;
+  for (const auto& pair : constraints.pairs())
+    for (int j = 0; j < pair.slave.n_nodes(); ++j)
+      if (pair.active[j]) error = std::max(error, std::abs(pair.pressure[j] - pressure) / pressure);
+  return error;
+}
+
+double HertzParameters::max_pressure() const {
+  const double E = effective_modulus();
+  if (!sphere) return std::sqrt(load * E / (M_PI * radius));
+  return std::cbrt(6.0 * load * E * E / (M_PI * M_PI * M_PI * radius * radius));
+}
+
+double HertzParameters::contact_size() const {
+  const double E = effective_modulus();
+  if (!sphere) return std::sqrt(4.0 * load * radius / (M_PI * E));
+  return std::cbrt(3.0 * load * radius / (4.0 * E));
+}
+
+HertzMeasurement measure_hertz(const ContactConstraints& constraints, bool sphere) {
+  HertzMeasurement m;
+  // Least squares of p² = A − B r² over the active nodes: b = √(A/B), p₀ = √A.
+  double s1 = 0, sx = 0, sxx = 0, sy = 0, sxy = 0;
+  for (const auto& pair : constraints.pairs()) {
+    const int dim = pair.slave.dim;
+    for (int j = 0; j < pair.slave.n_nodes(); ++j) {
+      if (!pair.active[j]) continue;
+      const double* x = pair.slave.reference.data() + static_cast<std::size_t>(j) * dim;
+      const double r = sphere ? std::hypot(x[0], x[1]) : std::abs(x[0]);
+      const double p = pair.pressure[j];
+      ++m.active_nodes;
+      m.max_pressure = std::max(m.max_pressure, p);
+      m.outermost_active = std::max(m.outermost_active, r);
+      const double X = r * r, Y = p * p;
+      s1 += 1;
+      sx += X;
+      sxx += X * X;
+      sy += Y;
+      sxy += X * Y;
+    }
+  }
+  const double det = s1 * sxx - sx * sx;
+  if (m.active_nodes >= 2 && det > 0) {
+    const double A = (sxx * sy - sx * sxy) / det;
+    const double slope = (s1 * sxy - sx * sy) / det;  // −B
+    if (A > 0 && slope < 0) {
+      m.fitted_pressure = std::sqrt(A);
+      m.contact_size = std::sqrt(-A / slope);
+    }
+  }
+  return m;
+}
+
+ContactHook::ContactHook(const ContactParameters& parameters, const solid::SolidModel& solid)
+    : parameters_(parameters),
+      constraints_(parameters, solid.mesh(), solid.dirichlet_dofs(), solid.displacement()) {}
+
+void ContactHook::begin_step(Vec u) {
+  (void)u;
+  constraints_.begin_step();
+  changing_iterations_ = 0;
+}
+
+void ContactHook::add_residual(Vec u, Vec residual) {
+  constraints_.update(u, residual);
+}
+
+Mat ContactHook::linear_system(Vec u, Mat K, Vec rhs) {
+  (void)u;
+  return constraints_.transform(K, rhs);
+}
+
+bool ContactHook::accept(Vec u) {
+  (void)u;
+  const auto& status = constraints_.status();
+  if (status.changes == 0) return true;
+  ++changing_iterations_;
+  log::debug("contact: {} node(s) changed the active set ({} active)", status.changes,
+             status.active);
+  if (changing_iterations_ > parameters_.max_active_set_changes)
+    throw ConvergenceError(fmt::format(
+        "contact: the active set still changes after {} Newton iterations ({} of {} nodes "
+        "active, {} changing): cycling; try a larger complementarity_constant or smaller "
+        "load steps",
+        changing_iterations_ - 1, status.active, status.constrained, status.changes));
+  return false;
+}
+
+std::vector<io::Field> ContactHook::fields() {
+  constraints_.vertex_fields(pressure_, gap_, active_);
+  return {{"contact_pressure", 1, io::Field::Location::vertex, pressure_},
+          {"contact_gap", 1, io::Field::Location::vertex, gap_},
+          {"contact_active", 1, io::Field::Location::vertex, active_}};
+}
+
+void ContactHook::add_series(run::RunOutput& output) const {
+  const auto& s = constraints_.status();
+  auto& series = output.series();
+  series.add("contact_active_nodes", s.active);
+  series.add("contact_max_pressure", s.max_pressure);
+  series.add("contact_total_force", s.total_force);
+  series.add("contact_max_penetration", s.max_penetration);
+}
+
+void ContactHook::write_nodes(const std::filesystem::path& file, MPI_Comm comm) const {
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  if (rank != 0) return;
+  std::ofstream out(file);
+  if (!out) throw Error(fmt::format("cannot write {}", file.string()));
+  const int dim = constraints_.pairs().empty() ? 0 : constraints_.pairs().front().slave.dim;
+  out << "pair,x,y" << (dim == 3 ? ",z" : "") << ",pressure,gap,active,constrained\n";
+  for (std::size_t p = 0; p < constraints_.pairs().size(); ++p) {
+    const auto& pair = constraints_.pairs()[p];
+    for (int j = 0; j < pair.slave.n_nodes(); ++j) {
+      out << p;
+      for (int i = 0; i < dim; ++i)
+        out << fmt::format(",{:.17g}", pair.slave.reference[static_cast<std::size_t>(j) * dim + i]);
+      out << fmt::format(",{:.17g},{:.17g},{},{}\n", pair.pressure[j], pair.mortar.gap(j),
+                         int(pair.active[j]), int(pair.mortar.constrained(j)));
+    }
+  }
+}
+
+void ContactHook::log_status(const std::string& label) const {
+  const auto& s = constraints_.status();
+  log::info(
+      "{}: contact {} of {} nodes active, pressure in [{:.6e}, {:.6e}] Pa, force {:.6e}, max "
+      "penetration {:.3e} m, max |p g| {:.3e}, c = {:.3e} Pa/m",
+      label, s.active, s.constrained, s.min_active_pressure, s.max_pressure, s.total_force,
+      s.max_penetration, s.max_complementarity, s.complementarity_constant);
+}
+
+}  // namespace coapt::contact

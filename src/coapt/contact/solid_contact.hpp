@@ -1,0 +1,104 @@
+#pragma once
+/// @file solid_contact.hpp
+/// Contact in the solid's Newton iteration: a solid::NewtonHook over ContactConstraints
+/// (contact_constraints.hpp), its output (VTU fields, series columns, summary figures), and
+/// the Hertz comparison of the `hertz:` case section.
+///
+///   hertz:                       analytic reference (Johnson 1985, refs §5), optional
+///     geometry: cylinder         cylinder (2D line contact) or sphere (3D point contact)
+///     radius: 1.0                R [m] of the elastic body pressed on a rigid flat
+///     load: 2.0e5                the whole body's load P [N/m for a cylinder, N for a sphere]
+///     young_modulus: 1e8         E [Pa] and ν of the body: E* = E / (1 − ν²)
+///     poisson_ratio: 0.3
+///
+///   patch_test: {force: 1.0e5}      the total normal load [N/m, N] a patch test transmits
+///
+/// The model may be a symmetric part of the body: the contact zone is measured from the
+/// symmetry axis x = 0 (2D; the contact normal along y) or x = y = 0 (3D; normal along z).
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "coapt/contact/contact_constraints.hpp"
+#include "coapt/contact/contact_parameters.hpp"
+#include "coapt/core/config.hpp"
+#include "coapt/io/json.hpp"
+#include "coapt/io/vtk_writer.hpp"
+#include "coapt/run/run_output.hpp"
+#include "coapt/solid/solid_model.hpp"
+
+namespace coapt::contact {
+
+/// The `hertz:` section (see the file comment); absent: `enabled` false.
+struct HertzParameters {
+  bool enabled = false;
+  bool sphere = false;
+  double radius = 0.0;
+  double load = 0.0;
+  double young_modulus = 0.0;
+  double poisson_ratio = 0.0;
+  static HertzParameters read(const config::Section& root);
+  /// E* = E / (1 − ν²) [Pa].
+  double effective_modulus() const { return young_modulus / (1.0 - poisson_ratio * poisson_ratio); }
+  /// Peak pressure p₀ [Pa]: line √(P E*/(π R)), point (6 P E*²/(π³ R²))^(1/3).
+  double max_pressure() const;
+  /// Contact half-width b = √(4 P R/(π E*)) (line) or radius a = (3 P R/(4 E*))^(1/3) [m].
+  double contact_size() const;
+};
+
+/// The `patch_test:` section: the total normal load a contact patch test must transmit.
+struct PatchTestParameters {
+  bool enabled = false;
+  double force = 0.0;  ///< [N/m in 2D, N in 3D]
+  static PatchTestParameters read(const config::Section& root);
+};
+
+/// Max |p_j − p| / p over the active nodes of every pair, p = force / contact measure (the
+/// uniform Cauchy pressure that carries the load over the current contact surface).
+double pressure_error(const ContactConstraints& constraints, double force);
+
+/// Measured Hertz figures from the slave pressures.
+struct HertzMeasurement {
+  double max_pressure = 0.0;  ///< largest nodal pressure [Pa]
+  double contact_size = 0.0;  ///< b or a from the fit p² = p₀² (1 − r²/b²) over the active nodes
+  double fitted_pressure = 0.0;   ///< p₀ of that fit [Pa]
+  double outermost_active = 0.0;  ///< largest r of an active node [m]
+  int active_nodes = 0;
+};
+
+/// Fits the Hertz profile to the active nodes of every pair (r from the axis, file comment).
+HertzMeasurement measure_hertz(const ContactConstraints& constraints, bool sphere);
+
+/// The Newton hook: the contact transformation at every residual and linear system, and the
+/// active-set test for convergence.
+class ContactHook final : public solid::NewtonHook {
+ public:
+  /// Gathers the contact surfaces of the solid's mesh. Collective.
+  ContactHook(const ContactParameters& parameters, const solid::SolidModel& solid);
+
+  void begin_step(Vec u) override;
+  void add_residual(Vec u, Vec residual) override;
+  Mat linear_system(Vec u, Mat K, Vec rhs) override;
+  bool accept(Vec u) override;
+
+  const ContactConstraints& constraints() const { return constraints_; }
+  /// The contact fields for SolidModel::write_vtk (pressure, gap, active set).
+  std::vector<io::Field> fields();
+  /// Adds the contact columns of the current state to the series row being built.
+  void add_series(run::RunOutput& output) const;
+  /// Writes every slave node of every pair as a CSV row (pair, reference coordinates,
+  /// pressure [Pa], gap [m], active, constrained) to `file`, on rank 0 only. Collective.
+  void write_nodes(const std::filesystem::path& file, MPI_Comm comm) const;
+  /// Logs the contact state after a step.
+  void log_status(const std::string& label) const;
+
+ private:
+  ContactParameters parameters_;
+  ContactConstraints constraints_;
+  int changing_iterations_ = 0;
+  std::vector<double> pressure_, gap_, active_;
+};
+
+}  // namespace coapt::contact

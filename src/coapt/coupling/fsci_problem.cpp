@@ -1,0 +1,771 @@
+#include "coapt/coupling/fsci_problem.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include "coapt/core/context.hpp"
+#include "coapt/core/error.hpp"
+#include "coapt/core/log.hpp"
+#include "coapt/core/progress.hpp"
+#include "coapt/coupling/immersed_constraint.hpp"
+#include "coapt/fem/assembly.hpp"
+#include "coapt/fluid/fluid_model.hpp"
+#include "coapt/mesh/mesh_input.hpp"
+#include "coapt/solid/solid_model.hpp"
+
+namespace coapt::coupling {
+namespace {
+
+using config::Bounds;
+
+/// One entry of `solids:`.
+struct SolidEntry {
+  std::string name;
+  std::string where;  ///< file:line of the entry
+  bool rigid = true;
+  mesh::MeshInput mesh;          ///< rigid: the mesh (deformable: solid::SolidModel reads it)
+  std::vector<double> velocity;  ///< rigid: translation velocity [m/s]
+  std::unique_ptr<config::Section> section;  ///< deformable: the entry, for solid::SolidModel
+};
+
+/// The block Gauss–Seidel iteration of a step with deformable solids.
+struct CouplingSettings {
+  double absolute_tolerance = 1e-8;  ///< on ‖f^l − f^(l−1)‖ [N/m in 2D, N]
+  double relative_tolerance = 1e-6;  ///< on ‖f^l − f^(l−1)‖ / ‖f^1‖
+  int max_iterations = 50;
+  double relaxation = 0.5;  ///< ω of the first iteration (then Aitken's, if enabled)
+  bool aitken = true;
+  int retries = 2;  ///< stronger relaxation, then (transient) halved steps
+};
+
+/// `benchmark:` of an immersed body in a channel (the DFG cylinder).
+struct Benchmark {
+  std::string type = "none";  ///< none | cylinder | forces
+  std::string body;           ///< cylinder: the solid whose force is reported
+  // forces: drag and lift = Σ of these fluid boundary groups' and solids' forces; a probe
+  std::vector<std::string> boundaries, solids;
+  std::string probe_solid, probe;
+  double reference_drag_force = 0, reference_lift_force = 0;
+  double reference_displacement_x = 0, reference_displacement_y = 0;
+  double mean_velocity = 1, diameter = 1;
+  std::vector<double> pressure_points;  ///< x_A, y_A, x_B, y_B: Δp = p(A) − p(B)
+  double reference_drag = 0, reference_lift = 0, reference_pressure_difference = 0;
+};
+
+struct Parameters {
+  int level = 0;  ///< added to every mesh's level
+  fluid::FluidCase fluid;
+  std::vector<SolidEntry> solids;
+  transfer::TransferOptions transfer;
+  CouplingSettings coupling;
+  fluid::TimeSettings time;
+  Benchmark benchmark;
+  bool write_vtk = true;
+};
+
+Parameters read(const config::Section& root) {
+  Parameters p;
+  p.level = root.section("mesh", "refinement of every mesh of the case")
+                .get<int>("level", 0,
+                          {"",
+                           "added to the refinement level of the fluid mesh and of every solid "
+                           "mesh (each level halves the element sizes)",
+                           Bounds::closed(0, 12)});
+  const auto fluid = root.section(
+      "fluid", "the fluid: mesh, boundary, outlets, pressure_reference and its material keys");
+  p.fluid = fluid::FluidCase::read(fluid, fluid);
+  for (const auto& entry : root.sections("solids", "the immersed solids, each with its mesh")) {
+    SolidEntry solid;
+    solid.where = entry.where();
+    solid.name = entry.require<std::string>("name", {"", "name of the solid (series columns)"});
+    solid.rigid = entry.get<bool>(
+        "rigid", true,
+        {"",
+         "true: a rigid body moving with `velocity`; false: a deformable solid with the keys "
+         "of `problem: solid` (mesh, bodies, dirichlet, probes, newton, ...)"});
+    if (solid.rigid) {
+      solid.mesh =
+          mesh::MeshInput::read(entry.section("mesh", "the solid's mesh"), entry.case_directory());
+      solid.velocity = entry.get<std::vector<double>>(
+          "velocity", {}, {"m/s", "rigid: translation velocity of the body (empty: at rest)"});
+    } else {
+      solid.section = std::make_unique<config::Section>(entry);
+    }
+    for (const auto& other : p.solids)
+      if (other.name == solid.name)
+        entry.fail("name", fmt::format("'{}' is already the name of a solid ({})", solid.name,
+                                       other.where));
+    p.solids.push_back(std::move(solid));
+  }
+  if (p.solids.empty()) root.fail("solids", "an fsci case needs at least one solid");
+  auto coupling = root.section("coupling", "the fluid-solid coupling");
+  p.transfer.coverage_threshold = coupling.get<double>(
+      "coverage_threshold", 1.0 - 1e-10,
+      {"",
+       "a fluid node is constrained when this fraction of its support lies in a solid "
+       "(covered-node rule; 1 - 1e-10: whole support)",
+       Bounds{0.0, 1.0, true, false}});
+  p.transfer.search_margin = coupling.get<double>(
+      "search_margin", 0.0,
+      {"m", "motion of a solid the transfer's search structure absorbs before a rebuild",
+       Bounds::non_negative()});
+  auto iteration = coupling.section(
+      "iteration", "block Gauss-Seidel iteration of each step with deformable solids");
+  auto& c = p.coupling;
+  c.absolute_tolerance = iteration.get<double>(
+      "absolute_tolerance", 1e-8,
+      {"N",
+       "stop when the change of the solids' force vectors B^T lambda is below this "
+       "(N/m in 2D)",
+       Bounds::non_negative()});
+  c.relative_tolerance = iteration.get<double>(
+      "relative_tolerance", 1e-6,
+      {"", "or when that change is below this fraction of the first iteration's force",
+       Bounds::non_negative()});
+  c.max_iterations = iteration.get<int>("max_iterations", 50,
+                                        {"", "iterations per try", Bounds::closed(1, 10000)});
+  c.relaxation = iteration.get<double>(
+      "relaxation", 0.5,
+      {"", "relaxation factor of the force (first iteration)", Bounds{0, 1, true, false}});
+  c.aitken = iteration.get<bool>("aitken", true, {"", "Aitken's dynamic relaxation"});
+  c.retries = iteration.get<int>(
+      "retries", 2,
+      {"", "failed step: retry with half the relaxation, then (transient) with half the step",
+       Bounds::closed(0, 10)});
+  p.time = fluid::TimeSettings::read(root);
+
+  auto benchmark = root.section("benchmark", "benchmark quantities written to summary.json");
+  auto& b = p.benchmark;
+  b.type = benchmark.choice(
+      "type", "none", {"none", "cylinder", "forces"},
+      {"",
+       "none | cylinder (force coefficients of an immersed body) | forces (drag, lift [N/m] "
+       "of boundary groups and solids, a probe's displacement)"});
+  if (b.type == "forces") {
+    b.boundaries = benchmark.get<std::vector<std::string>>(
+        "boundaries", {}, {"", "fluid boundary groups whose force adds to drag and lift"});
+    b.solids = benchmark.get<std::vector<std::string>>(
+        "solids", {}, {"", "solids whose force B^T lambda adds to drag and lift"});
+    b.probe_solid = benchmark.get<std::string>("probe_solid", "", {"", "solid of the probe"});
+    b.probe = benchmark.get<std::string>(
+        "probe", "", {"", "a probe of that solid: displacement_x, displacement_y"});
+    auto reference = benchmark.section("reference", "published values (relative errors)");
+    b.reference_drag_force = reference.get<double>("drag", 0.0, {"N/m", "drag (0: none)"});
+    b.reference_lift_force = reference.get<double>("lift", 0.0, {"N/m", "lift (0: none)"});
+    b.reference_displacement_x =
+        reference.get<double>("displacement_x", 0.0, {"m", "probe u_x (0: none)"});
+    b.reference_displacement_y =
+        reference.get<double>("displacement_y", 0.0, {"m", "probe u_y (0: none)"});
+    for (const auto& name : b.solids)
+      if (std::none_of(p.solids.begin(), p.solids.end(),
+                       [&](const SolidEntry& s) { return s.name == name; }))
+        benchmark.fail("solids", fmt::format("no solid named '{}' in `solids`", name));
+  }
+  if (b.type == "cylinder") {
+    b.body = benchmark.require<std::string>("body", {"", "name of the solid"});
+    b.mean_velocity = benchmark.require<double>("mean_velocity",
+                                                {"m/s", "Ū of c = 2F/(ρŪ²D)", Bounds::positive()});
+    b.diameter =
+        benchmark.require<double>("diameter", {"m", "D of c = 2F/(ρŪ²D)", Bounds::positive()});
+    b.pressure_points = benchmark.get<std::vector<double>>(
+        "pressure_points", {}, {"m", "x_A, y_A, x_B, y_B: Δp = p(A) − p(B)"});
+    if (!b.pressure_points.empty() && b.pressure_points.size() != 4)
+      benchmark.fail("pressure_points", "give 4 numbers: x_A, y_A, x_B, y_B (2D)");
+    auto reference = benchmark.section("reference", "published values (relative errors)");
+    b.reference_drag = reference.get<double>("drag_coefficient", 0.0, {"", "c_D (0: none)"});
+    b.reference_lift = reference.get<double>("lift_coefficient", 0.0, {"", "c_L (0: none)"});
+    b.reference_pressure_difference =
+        reference.get<double>("pressure_difference", 0.0, {"Pa", "Δp (0: none)"});
+    if (std::none_of(p.solids.begin(), p.solids.end(),
+                     [&](const SolidEntry& s) { return s.name == b.body; }))
+      benchmark.fail("body", fmt::format("no solid named '{}' in `solids`", b.body));
+  }
+  p.write_vtk = root.section("output", "what the run writes")
+                    .get<bool>("vtk", true, {"", "write the fluid and the solids as VTK"});
+  return p;
+}
+
+/// A solid in the coupling: its mesh and its constraint with the fluid.
+struct Solid {
+  const SolidEntry* entry = nullptr;
+  mesh::QualityReport quality;               ///< rigid
+  std::unique_ptr<solid::SolidModel> model;  ///< deformable
+  mesh::Mesh mesh;  ///< the current configuration (rigid: moved in place; deformable: X + u)
+  std::unique_ptr<ImmersedConstraint> constraint;
+  std::size_t first = 0;  ///< offset of its vertices in the fluid's constrained list
+  OwnedVec force;         ///< Bᵀλ of the last fluid solve (solid vertex vector, dim components)
+  std::vector<double> total_force;
+  // deformable: the force the solid is loaded with (relaxed), its value at the step's start,
+  // and the last residual f − f_applied (Aitken)
+  OwnedVec applied, applied_start, residual, previous_residual;
+};
+
+/// What the coupling iterations of one step did.
+struct CouplingReport {
+  int iterations = 0;
+  int tries = 1;
+  std::vector<double> history;     ///< ‖f^l − f_applied^l‖ per iteration
+  std::vector<double> relaxation;  ///< ω per iteration
+  fluid::NewtonReport fluid;       ///< the last fluid solve
+};
+
+class FsciProblem final : public run::Problem {
+ public:
+  FsciProblem(const config::Section& root, MPI_Comm comm)
+      : parameters_(read(root)), comm_(comm), fluid_(parameters_.fluid, comm, parameters_.level) {
+    const int dim = fluid_.mesh().dim;
+    for (const auto& entry : parameters_.solids) {
+      auto solid = std::make_unique<Solid>();
+      solid->entry = &entry;
+      if (entry.rigid) {
+        auto input = entry.mesh;
+        fluid::add_refinement_levels(input, parameters_.level, "mesh.level");
+        solid->mesh = mesh::load_mesh(input, comm, &solid->quality);
+        if (!entry.velocity.empty() && static_cast<int>(entry.velocity.size()) != dim)
+          throw InputError(fmt::format("{}: velocity: needs {} components", entry.where, dim));
+      } else {
+        solid->model = std::make_unique<solid::SolidModel>(*entry.section, comm);
+        solid->mesh = solid->model->mesh();
+        solid->quality = solid->model->quality();
+        deformable_ = true;
+      }
+      if (solid->mesh.dim != dim)
+        throw InputError(fmt::format("{}: mesh: the solid's mesh is {}D, the fluid's {}D",
+                                     entry.where, solid->mesh.dim, dim));
+      solids_.push_back(std::move(solid));
+    }
+    const auto& b = parameters_.benchmark;
+    if (!b.pressure_points.empty() && dim != 2)
+      throw InputError("benchmark.pressure_points: the pressure probes are a 2D quantity");
+    for (const auto& group : b.boundaries)
+      boundary_tags_.push_back(fluid_.boundary_tag(group, "benchmark.boundaries"));
+    if (!b.probe.empty()) {
+      const Solid* owner = find_solid(b.probe_solid);
+      if (!owner || !owner->model)
+        throw InputError(fmt::format(
+            "benchmark.probe_solid: '{}' is not a deformable solid of `solids`", b.probe_solid));
+      const auto& probes = owner->model->parameters().probes;
+      for (std::size_t k = 0; k < probes.size(); ++k)
+        if (probes[k].name == b.probe) probe_index_ = static_cast<int>(k);
+      if (probe_index_ < 0)
+        throw InputError(
+            fmt::format("benchmark.probe: solid '{}' has no probe '{}'", b.probe_solid, b.probe));
+    }
+  }
+
+  void describe() const override {
+    fluid_.describe(
+        fmt::format("fsci: {} fluid", parameters_.time.steady ? "steady" : "transient"));
+    for (const auto& solid : solids_) {
+      const auto& entry = *solid->entry;
+      if (solid->model) {
+        log::info("solid '{}' (deformable):", entry.name);
+        solid->model->describe();
+        continue;
+      }
+      log::info("solid '{}': {}, {} cells, {} vertices, shape quality in [{:.3f}, {:.3f}]; {}",
+                entry.name, entry.mesh.describe(), solid->mesh.n_global_cells,
+                solid->mesh.n_global_vertices, solid->quality.min_shape, solid->quality.max_shape,
+                entry.velocity.empty()
+                    ? std::string("rigid, at rest")
+                    : fmt::format("rigid, velocity ({}) m/s", fmt::join(entry.velocity, ", ")));
+    }
+    const auto& c = parameters_.coupling;
+    log::info("coupling: a fluid node is constrained when {:.10g} of its support is covered",
+              parameters_.transfer.coverage_threshold);
+    if (deformable_)
+      log::info(
+          "coupling: block Gauss-Seidel, |df| < {:g} or |df|/|f^1| < {:g}, at most {} iterations, "
+          "relaxation {:g}{}",
+          c.absolute_tolerance, c.relative_tolerance, c.max_iterations, c.relaxation,
+          c.aitken ? " then Aitken" : "");
+  }
+
+  void run(run::RunOutput& output) override {
+    describe();
+    fluid_.start(0.0);
+    {
+      ScopedTimer timer(output.timers(), "transfer");
+      for (auto& solid : solids_) {
+        solid->constraint =
+            std::make_unique<ImmersedConstraint>(fluid_.mesh(), solid->mesh, parameters_.transfer);
+        solid->force = solid->constraint->create_solid_vector();
+        if (!solid->model) continue;
+        for (auto* v : {&solid->applied, &solid->applied_start, &solid->residual,
+                        &solid->previous_residual}) {
+          *v = solid->constraint->create_solid_vector();
+          COAPT_PETSC_CHECK(VecSet(*v, 0.0));
+        }
+        solid->model->set_external_force(solid->applied);
+      }
+    }
+    const auto& p = parameters_;
+    if (!p.time.steady)
+      for (auto& solid : solids_)
+        if (solid->model) {  // the fluid mesh carries ρ_f over the overlap
+          solid->model->set_density_offset(p.fluid.fluid.density);
+          solid->model->initialize_dynamics(output);
+        }
+    int newton_total = 0, linear_total = 0, coupling_total = 0;
+    if (p.time.steady) {
+      const auto report = coupled_step(output, 0.0, 0.0, p.coupling.relaxation);
+      if (!report.converged) {
+        // the last iterate's quantities stay in the summary next to the failure
+        record_step(output, 0.0, report.coupling);
+        benchmark(output);
+        output.summary()["coupling_history"] = io::Json::array_of(report.coupling.history);
+      }
+      if (!report.converged)
+        throw ConvergenceError(
+            fmt::format("fsci: the steady coupling did not converge in {} iterations; |df| "
+                        "history {:.3e}",
+                        report.coupling.iterations, fmt::join(report.coupling.history, ", ")));
+      newton_total = report.coupling.fluid.iterations;
+      linear_total = report.coupling.fluid.linear_iterations;
+      coupling_total = report.coupling.iterations;
+      record_step(output, 0.0, report.coupling);
+    } else {
+      Progress progress(p.time.n_steps(), p.time.end_time);
+      int step = 0;
+      while (fluid_.time() < p.time.end_time * (1 - 1e-12)) {
+        const double dt = std::min(p.time.time_step, p.time.end_time - fluid_.time());
+        const auto report = step_with_retries(output, dt);
+        ++step;
+        newton_total += report.fluid.iterations;
+        linear_total += report.fluid.linear_iterations;
+        coupling_total += report.iterations;
+        record_step(output, fluid_.time(), report);
+        progress.step(
+            std::min(step, p.time.n_steps()), fluid_.time(),
+            fmt::format("coupling {}, newton {}", report.iterations, report.fluid.iterations));
+      }
+    }
+    fluid_.write_windkessel_states(output);
+    auto& iterations = output.summary()["iterations"];
+    iterations["newton"] = newton_total;
+    iterations["linear"] = linear_total;
+    iterations["coupling"] = coupling_total;
+    {
+      ScopedTimer timer(output.timers(), "benchmark");
+      benchmark(output);
+    }
+    if (p.write_vtk) {
+      ScopedTimer timer(output.timers(), "output");
+      write_vtk(output, p.time.steady ? 0.0 : p.time.end_time);
+    }
+  }
+
+ private:
+  struct StepResult {
+    bool converged = false;
+    CouplingReport coupling;
+  };
+
+  Solid* find_solid(const std::string& name) const {
+    for (const auto& solid : solids_)
+      if (solid->entry->name == name) return solid.get();
+    return nullptr;
+  }
+
+  /// One transient step of size dt, committed; a step whose coupling fails is retried with half
+  /// the relaxation, then with half the step (the remaining time is covered by later steps);
+  /// after `retries` failures the run fails with the history. The added-mass effect can make a
+  /// smaller step worse, which is why the relaxation is tried first.
+  CouplingReport step_with_retries(run::RunOutput& output, double dt) {
+    const auto& c = parameters_.coupling;
+    double relaxation = c.relaxation, step = dt;
+    std::string failures;
+    for (int attempt = 0; attempt <= c.retries; ++attempt) {
+      if (attempt > 0) {
+        if (attempt == 1 || !deformable_)
+          relaxation *= 0.5;
+        else
+          step *= 0.5;
+        log::info("fsci: retrying the step to t = {:g} s with relaxation {:g} and step {:g} s",
+                  fluid_.time() + step, relaxation, step);
+      }
+      fluid_.begin_step(step);
+      StepResult result;
+      try {
+        result = coupled_step(output, fluid_.time(), step, relaxation);
+      } catch (const ConvergenceError& error) {
+        result.converged = false;
+        failures += fmt::format("\n  try {}: {}", attempt + 1, error.what());
+      }
+      if (result.converged) {
+        fluid_.commit_step();
+        for (auto& solid : solids_)
+          if (solid->model) solid->model->commit();
+        result.coupling.tries = attempt + 1;
+        return result.coupling;
+      }
+      if (!result.coupling.history.empty())
+        failures +=
+            fmt::format("\n  try {} (step {:g} s, relaxation {:g}): |df| {:.3e}", attempt + 1, step,
+                        relaxation, fmt::join(result.coupling.history, ", "));
+      fluid_.restore_step();
+      for (auto& solid : solids_)
+        if (solid->model) {
+          solid->model->restore();
+          COAPT_PETSC_CHECK(VecCopy(solid->applied_start, solid->applied));
+        }
+    }
+    throw ConvergenceError(fmt::format("fsci: the step from t = {:g} s failed after {} tries:{}",
+                                       fluid_.time(), c.retries + 1, failures));
+  }
+
+  /// The coupling iterations of one step (steady: dt = 0): (1) the deformable solids loaded by
+  /// the relaxed force, (2) their current configuration into the transfer, (3) the fluid with
+  /// v_f = T v_s, (4) f = Bᵀλ and the relaxed update f_applied += ω (f − f_applied), until the
+  /// change ‖f − f_applied‖ meets the tolerances. Rigid solids alone need one pass.
+  StepResult coupled_step(run::RunOutput& output, double time, double dt, double relaxation) {
+    const auto& c = parameters_.coupling;
+    const bool steady = dt <= 0;
+    StepResult result;
+    auto& report = result.coupling;
+    if (!steady) {
+      ScopedTimer timer(output.timers(), "transfer");
+      move_rigid_solids(dt);
+    }
+    for (auto& solid : solids_)
+      if (solid->model) COAPT_PETSC_CHECK(VecCopy(solid->applied, solid->applied_start));
+    double omega = relaxation, first_norm = 0;
+    for (int iteration = 1; iteration <= (deformable_ ? c.max_iterations : 1); ++iteration) {
+      report.iterations = iteration;
+      for (auto& solid : solids_) {  // (1) and (2)
+        if (!solid->model) continue;
+        {
+          ScopedTimer timer(output.timers(), "solid");
+          if (steady)
+            solid->model->solve_static(
+                1.0, output,
+                fmt::format("solid '{}', coupling iteration {}", solid->entry->name, iteration),
+                false);
+          else
+            solid->model->step(time, dt, output);
+        }
+        ScopedTimer timer(output.timers(), "transfer");
+        const auto coordinates = solid->model->current_coordinates();
+        std::copy(coordinates.begin(), coordinates.end(), solid->mesh.coordinates.begin());
+        solid->constraint->update_solid(solid->mesh);
+      }
+      apply_constraint(steady);  // (3)
+      {
+        ScopedTimer timer(output.timers(), "fluid");
+        report.fluid =
+            steady ? fluid_.solve_steady(fmt::format("fluid, coupling iteration {}", iteration))
+                   : fluid_.solve(fmt::format("fluid to t = {:g} s, coupling "
+                                              "iteration {}",
+                                              time, iteration));
+      }
+      ScopedTimer timer(output.timers(), "coupling");
+      compute_forces();  // (4)
+      if (!deformable_) {
+        result.converged = true;
+        return result;
+      }
+      // r = f − f_applied over the deformable solids; Aitken's ω from the last two.
+      double norm2 = 0, force2 = 0, dot = 0, difference2 = 0;
+      for (auto& solid : solids_) {
+        if (!solid->model) continue;
+        COAPT_PETSC_CHECK(VecWAXPY(solid->residual, -1.0, solid->applied, solid->force));
+        double n = 0, f = 0;
+        COAPT_PETSC_CHECK(VecNorm(solid->residual, NORM_2, &n));
+        COAPT_PETSC_CHECK(VecNorm(solid->force, NORM_2, &f));
+        norm2 += n * n;
+        force2 += f * f;
+        if (iteration > 1) {
+          // dot = r_{l−1}·(r_l − r_{l−1}), difference2 = ‖r_l − r_{l−1}‖²
+          PetscScalar a = 0, b = 0;
+          COAPT_PETSC_CHECK(VecDot(solid->previous_residual, solid->residual, &a));
+          COAPT_PETSC_CHECK(VecDot(solid->previous_residual, solid->previous_residual, &b));
+          double m = 0;
+          COAPT_PETSC_CHECK(VecAYPX(solid->previous_residual, -1.0, solid->residual));
+          COAPT_PETSC_CHECK(VecNorm(solid->previous_residual, NORM_2, &m));
+          dot += a - b;
+          difference2 += m * m;
+        }
+        COAPT_PETSC_CHECK(VecCopy(solid->residual, solid->previous_residual));
+      }
+      const double norm = std::sqrt(norm2);
+      if (iteration == 1) first_norm = std::sqrt(force2);
+      report.history.push_back(norm);
+      if (iteration > 1 && c.aitken && difference2 > 0)
+        omega = std::clamp(-omega * dot / difference2, 0.01, 1.0);
+      report.relaxation.push_back(omega);
+      if (norm <= c.absolute_tolerance || norm <= c.relative_tolerance * first_norm) {
+        result.converged = true;
+        break;
+      }
+      for (auto& solid : solids_)
+        if (solid->model) COAPT_PETSC_CHECK(VecAXPY(solid->applied, omega, solid->residual));
+    }
+    log::info("{}: {} coupling iteration(s){}, |f - f_applied| {:.3e}; omega {:.3f}",
+              steady ? std::string("steady") : fmt::format("t = {:g} s", time), report.iterations,
+              result.converged ? "" : " (not converged)", fmt::join(report.history, ", "),
+              fmt::join(report.relaxation, ", "));
+    return result;
+  }
+
+  /// Rigid solids with a velocity translate by dt·velocity; their operators are re-assembled.
+  void move_rigid_solids(double dt) {
+    for (auto& solid : solids_) {
+      if (solid->model) continue;
+      const auto& velocity = solid->entry->velocity;
+      if (velocity.empty() ||
+          std::all_of(velocity.begin(), velocity.end(), [](double v) { return v == 0.0; }))
+        continue;
+      const int dim = solid->mesh.dim;
+      for (std::size_t k = 0; k < solid->mesh.coordinates.size(); ++k)
+        solid->mesh.coordinates[k] += dt * velocity[k % dim];
+      solid->constraint->update_solid(solid->mesh);
+    }
+  }
+
+  /// v_f = T v_s at every solid's constrained fluid nodes (steady deformable solids: v_s = 0).
+  /// A fluid node constrained by two solids is an error for now (the valve will need a rule:
+  /// notes.md "Thin solids").
+  void apply_constraint(bool steady) {
+    const int dim = fluid_.mesh().dim;
+    std::vector<int> vertices;
+    std::vector<double> velocities;
+    for (auto& solid : solids_) {
+      solid->first = vertices.size();
+      const auto& constrained = solid->constraint->constrained_vertices();
+      std::vector<double> values;
+      if (solid->model && !steady) {
+        values = solid->constraint->transfer_velocity(solid->model->velocity());
+      } else {
+        const auto& velocity = solid->entry->velocity;
+        values = solid->constraint->transfer_uniform_velocity(
+            velocity.empty() ? std::vector<double>(static_cast<std::size_t>(dim), 0.0) : velocity);
+      }
+      vertices.insert(vertices.end(), constrained.begin(), constrained.end());
+      velocities.insert(velocities.end(), values.begin(), values.end());
+    }
+    auto sorted = vertices;
+    std::sort(sorted.begin(), sorted.end());
+    int shared = std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end() ? 1 : 0;
+    MPI_Allreduce(MPI_IN_PLACE, &shared, 1, MPI_INT, MPI_MAX, comm_);
+    if (shared)
+      throw InputError(
+          "solids: two solids constrain the same fluid node (overlapping solids are not "
+          "supported yet)");
+    fluid_.set_velocity_constraint(vertices, velocities);
+  }
+
+  /// λ = r/D and Bᵀλ of every solid from the fluid's constraint reactions; the balance
+  /// Σ Bᵀλ = Σ r per solid is recorded.
+  void compute_forces() {
+    const int dim = fluid_.mesh().dim;
+    const auto reactions = fluid_.constraint_reactions();
+    force_balance_ = 0;
+    for (auto& solid : solids_) {
+      const auto n = solid->constraint->constrained_vertices().size() * dim;
+      const std::vector<double> own(
+          reactions.begin() + static_cast<std::ptrdiff_t>(solid->first),
+          reactions.begin() + static_cast<std::ptrdiff_t>(solid->first + n));
+      const auto lambda = solid->constraint->multiplier(own);
+      solid->constraint->solid_force(lambda, solid->force);
+      fem::update_ghosts(solid->force);
+      solid->total_force = solid->constraint->sum_components(solid->force);
+      const auto total_reaction = solid->constraint->sum_constrained(own);
+      double difference = 0, size = 0;
+      for (int i = 0; i < dim; ++i) {
+        difference = std::max(difference, std::abs(solid->total_force[i] - total_reaction[i]));
+        size = std::max(size, std::abs(total_reaction[i]));
+      }
+      force_balance_ = std::max(force_balance_, difference / std::max(size, 1e-300));
+    }
+  }
+
+  /// c = 2F/(ρŪ²D) of the benchmark body.
+  double coefficient_scale() const {
+    const auto& b = parameters_.benchmark;
+    return 2.0 / (parameters_.fluid.fluid.density * b.mean_velocity * b.mean_velocity * b.diameter);
+  }
+
+  /// Drag and lift of the `forces` benchmark: the fluid's force on its boundary groups plus
+  /// the solids' Bᵀλ totals. Collective.
+  std::vector<double> benchmark_force() {
+    std::vector<double> force(static_cast<std::size_t>(fluid_.mesh().dim), 0.0);
+    for (const int tag : boundary_tags_) {
+      const auto f = fluid_.boundary_force(tag);
+      for (std::size_t i = 0; i < force.size(); ++i) force[i] += f[i];
+    }
+    for (const auto& name : parameters_.benchmark.solids) {
+      const auto& f = find_solid(name)->total_force;
+      for (std::size_t i = 0; i < force.size(); ++i) force[i] += f[i];
+    }
+    return force;
+  }
+
+  const Solid* benchmark_body() const {
+    for (const auto& solid : solids_)
+      if (solid->entry->name == parameters_.benchmark.body) return solid.get();
+    return nullptr;
+  }
+
+  void record_step(run::RunOutput& output, double time, const CouplingReport& coupling) {
+    const auto& report = coupling.fluid;
+    auto& series = output.series();
+    const int dim = fluid_.mesh().dim;
+    series.add("time", time);
+    series.add("newton_iterations", report.iterations);
+    series.add("linear_iterations", report.linear_iterations);
+    series.add("coupling_iterations", coupling.iterations);
+    series.add("coupling_tries", coupling.tries);
+    series.add("coupling_change", coupling.history.empty() ? 0.0 : coupling.history.back());
+    series.add("residual", report.residual_history.back());
+    for (const auto& solid : solids_) {
+      const auto& name = solid->entry->name;
+      static constexpr const char* axes[] = {"x", "y", "z"};
+      for (int i = 0; i < dim; ++i)
+        series.add(fmt::format("force_{}_{}", axes[i], name), solid->total_force[i]);
+      series.add("constrained_" + name, static_cast<double>(solid->constraint->n_constrained()));
+      if (!solid->model) continue;
+      const auto probes = solid->model->probe_values();
+      const auto& names = solid->model->parameters().probes;
+      for (std::size_t k = 0; k < probes.size(); ++k)
+        for (int i = 0; i < dim; ++i)
+          series.add(fmt::format("{}_{}_u{}", name, names[k].name, axes[i]), probes[k][i]);
+      series.add("kinetic_energy_" + name, solid->model->kinetic_energy());
+      series.add("volume_" + name, solid->model->volume());
+    }
+    if (parameters_.benchmark.type == "forces") {
+      const auto force = benchmark_force();
+      series.add("drag", force[0]);
+      series.add("lift", force[1]);
+    }
+    if (const auto* body = benchmark_body()) {
+      series.add("drag_coefficient", coefficient_scale() * body->total_force[0]);
+      series.add("lift_coefficient", coefficient_scale() * body->total_force[1]);
+    }
+    series.add("force_balance", force_balance_);
+    series.add("kinetic_energy_fluid", fluid_.kinetic_energy());
+    fluid_.record_flows(series);
+    series.end_row();
+  }
+
+  void benchmark(run::RunOutput& output) {
+    const auto& b = parameters_.benchmark;
+    const auto& mesh = fluid_.mesh();
+    auto& json = output.summary()["benchmark"];
+    json["cells"] = static_cast<std::int64_t>(mesh.n_global_cells);
+    json["vertices"] = static_cast<std::int64_t>(mesh.n_global_vertices);
+    json["force_balance_error"] = force_balance_;
+    for (const auto& solid : solids_) {
+      auto& entry = json["solids"][solid->entry->name];
+      entry["cells"] = static_cast<std::int64_t>(solid->mesh.n_global_cells);
+      entry["constrained_fluid_vertices"] =
+          static_cast<std::int64_t>(solid->constraint->n_constrained());
+      entry["force"] = io::Json::array_of(solid->total_force);
+      log::info("solid '{}': {} constrained fluid vertices, force ({:.8e}) N/m", solid->entry->name,
+                solid->constraint->n_constrained(), fmt::join(solid->total_force, ", "));
+    }
+    log::info("force balance: max |sum B^T lambda - sum reactions| / |sum reactions| = {:.3e}",
+              force_balance_);
+    if (b.type == "forces") {
+      const auto force = benchmark_force();
+      json["drag"] = force[0];
+      json["lift"] = force[1];
+      log::info("drag = {:.8g} N/m, lift = {:.8g} N/m", force[0], force[1]);
+      if (b.reference_drag_force != 0)
+        json["drag_error"] = std::abs(force[0] / b.reference_drag_force - 1);
+      if (b.reference_lift_force != 0)
+        json["lift_error"] = std::abs(force[1] / b.reference_lift_force - 1);
+      if (probe_index_ >= 0) {
+        const auto u = find_solid(b.probe_solid)->model->probe_values()[probe_index_];
+        json["displacement_x"] = u[0];
+        json["displacement_y"] = u[1];
+        log::info("probe '{}': u = ({:.8g}, {:.8g}) m", b.probe, u[0], u[1]);
+        if (b.reference_displacement_x != 0)
+          json["displacement_x_error"] = std::abs(u[0] / b.reference_displacement_x - 1);
+        if (b.reference_displacement_y != 0)
+          json["displacement_y_error"] = std::abs(u[1] / b.reference_displacement_y - 1);
+      }
+      return;
+    }
+    if (b.type != "cylinder") return;
+    const auto* body = benchmark_body();
+    const double drag = coefficient_scale() * body->total_force[0],
+                 lift = coefficient_scale() * body->total_force[1];
+    json["drag_force"] = body->total_force[0];
+    json["lift_force"] = body->total_force[1];
+    json["drag_coefficient"] = drag;
+    json["lift_coefficient"] = lift;
+    log::info("c_D = {:.8f}, c_L = {:.8f}", drag, lift);
+    if (b.reference_drag != 0) json["drag_error"] = std::abs(drag / b.reference_drag - 1);
+    if (b.reference_lift != 0) json["lift_error"] = std::abs(lift / b.reference_lift - 1);
+    if (!b.pressure_points.empty()) {
+      const auto pressure =
+          fluid::values_at(mesh, fluid_.state(), mesh.dim + 1, mesh.dim, b.pressure_points);
+      const double difference = pressure[0] - pressure[1];
+      json["pressure_difference"] = difference;
+      log::info("Delta p = {:.8f} Pa", difference);
+      if (b.reference_pressure_difference != 0)
+        json["pressure_difference_error"] =
+            std::abs(difference / b.reference_pressure_difference - 1);
+    }
+  }
+
+  /// The fluid (with a `constrained` marker) and each solid with its force Bᵀλ.
+  void write_vtk(run::RunOutput& output, double time) {
+    const auto& mesh = fluid_.mesh();
+    auto marker_vector = fem::create_vertex_vector(mesh, 1);
+    COAPT_PETSC_CHECK(VecSet(marker_vector, 0.0));
+    {
+      PetscScalar* values = nullptr;
+      COAPT_PETSC_CHECK(VecGetArray(marker_vector, &values));
+      for (std::size_t k = 0; k < solids_.size(); ++k)
+        for (const int v : solids_[k]->constraint->constrained_vertices())
+          values[v] = static_cast<double>(k + 1);
+      COAPT_PETSC_CHECK(VecRestoreArray(marker_vector, &values));
+    }
+    fem::update_ghosts(marker_vector);
+    std::vector<double> marker(static_cast<std::size_t>(mesh.n_vertices()));
+    {
+      fem::LocalValues local(marker_vector);
+      for (int v = 0; v < mesh.n_vertices(); ++v) marker[v] = local[static_cast<std::size_t>(v)];
+    }
+    fluid_.write_vtk(output, time,
+                     {{"constrained_by_solid", 1, io::Field::Location::vertex, marker}});
+    for (const auto& solid : solids_) {
+      const int dim = solid->mesh.dim;
+      std::vector<double> force(static_cast<std::size_t>(solid->mesh.n_vertices()) * dim);
+      {
+        fem::LocalValues local(solid->force);
+        for (std::size_t k = 0; k < force.size(); ++k) force[k] = local[k];
+      }
+      if (solid->model) {  // the solid's own series "solid", with the coupling force
+        solid->model->write_vtk(output, time,
+                                {{"coupling_force", dim, io::Field::Location::vertex, force}});
+        continue;
+      }
+      const std::vector<io::Field> fields = {{"force", dim, io::Field::Location::vertex, force}};
+      output.vtk("solid_" + solid->entry->name).write(solid->mesh, time, fields);
+    }
+  }
+
+  const Parameters parameters_;
+  MPI_Comm comm_;
+  fluid::FluidModel fluid_;
+  std::vector<std::unique_ptr<Solid>> solids_;
+  double force_balance_ = 0;        ///< max over solids of the relative force balance error
+  bool deformable_ = false;         ///< some solid is deformable: coupling iterations
+  std::vector<int> boundary_tags_;  ///< benchmark.boundaries
+  int probe_index_ = -1;            ///< benchmark.probe in its solid's probes
+};
+
+}  // namespace
+
+std::unique_ptr<run::Problem> create_fsci_problem(const config::Section& root, MPI_Comm comm) {
+  return std::make_unique<FsciProblem>(root, comm);
+}
+
+}  // namespace coapt::coupling

@@ -1,0 +1,126 @@
+#include "coapt/coupling/immersed_constraint.hpp"
+
+#include <fmt/format.h>
+#include <mpi.h>
+
+#include "coapt/core/error.hpp"
+#include "coapt/fem/assembly.hpp"
+
+namespace coapt::coupling {
+
+ImmersedConstraint::ImmersedConstraint(const mesh::Mesh& fluid, const mesh::Mesh& solid,
+                                       const transfer::TransferOptions& options)
+    : fluid_(fluid),
+      solid_(&solid),
+      transfer_(std::make_unique<transfer::VariationalTransfer>(fluid, solid, options)) {
+  if (fluid.dim != solid.dim)
+    throw InputError(fmt::format("immersed solid {} is {}D in a {}D fluid ({})", solid.source,
+                                 solid.dim, fluid.dim, fluid.source));
+  COAPT_PETSC_CHECK(VecCreateMPI(fluid.comm,
+                                 static_cast<PetscInt>(fluid.n_owned_vertices) * fluid.dim,
+                                 PETSC_DETERMINE, fluid_work_.out()));
+  collect();
+}
+
+void ImmersedConstraint::update_solid(const mesh::Mesh& moved) {
+  solid_ = &moved;
+  transfer_->update_master(moved);
+  collect();
+}
+
+void ImmersedConstraint::collect() {
+  // B ⊗ I_dim acts on interleaved vertex vectors; re-created because update_master may have
+  // re-created B.
+  COAPT_PETSC_CHECK(MatCreateMAIJ(transfer_->coupling(), fluid_.dim, coupling_.out()));
+  constrained_.clear();
+  dual_.clear();
+  const PetscScalar* dual = nullptr;
+  COAPT_PETSC_CHECK(VecGetArrayRead(transfer_->dual_mass(), &dual));
+  for (const PetscInt row : transfer_->constrained_rows()) {
+    const auto v = static_cast<int>(row - fluid_.vertex_offset);
+    if (v < 0 || v >= fluid_.n_owned_vertices || fluid_.global_vertex[v] != row)
+      throw InternalError("immersed constraint: a constrained row is not an owned fluid vertex");
+    constrained_.push_back(v);
+    dual_.push_back(dual[v]);
+  }
+  COAPT_PETSC_CHECK(VecRestoreArrayRead(transfer_->dual_mass(), &dual));
+}
+
+std::vector<double> ImmersedConstraint::transfer_velocity(Vec solid_velocity) const {
+  const int dim = fluid_.dim;
+  COAPT_PETSC_CHECK(MatMult(coupling_, solid_velocity, fluid_work_));
+  std::vector<double> velocities(constrained_.size() * dim);
+  const PetscScalar* product = nullptr;
+  COAPT_PETSC_CHECK(VecGetArrayRead(fluid_work_, &product));
+  for (std::size_t q = 0; q < constrained_.size(); ++q)
+    for (int i = 0; i < dim; ++i)
+      velocities[q * dim + i] =
+          product[static_cast<std::size_t>(constrained_[q]) * dim + i] / dual_[q];
+  COAPT_PETSC_CHECK(VecRestoreArrayRead(fluid_work_, &product));
+  return velocities;
+}
+
+std::vector<double> ImmersedConstraint::transfer_uniform_velocity(
+    const std::vector<double>& velocity) const {
+  const int dim = solid_->dim;
+  if (static_cast<int>(velocity.size()) != dim)
+    throw InternalError("transfer_uniform_velocity: needs dim components");
+  auto solid_velocity = create_solid_vector();
+  PetscScalar* values = nullptr;
+  COAPT_PETSC_CHECK(VecGetArray(solid_velocity, &values));
+  for (int v = 0; v < solid_->n_owned_vertices; ++v)
+    for (int i = 0; i < dim; ++i) values[static_cast<std::size_t>(v) * dim + i] = velocity[i];
+  COAPT_PETSC_CHECK(VecRestoreArray(solid_velocity, &values));
+  return transfer_velocity(solid_velocity);
+}
+
+std::vector<double> ImmersedConstraint::multiplier(const std::vector<double>& reactions) const {
+  const int dim = fluid_.dim;
+  if (reactions.size() != constrained_.size() * dim)
+    throw InternalError("immersed constraint: reactions must be constrained vertices × dim");
+  std::vector<double> lambda(reactions.size());
+  for (std::size_t q = 0; q < constrained_.size(); ++q)
+    for (int i = 0; i < dim; ++i) lambda[q * dim + i] = reactions[q * dim + i] / dual_[q];
+  return lambda;
+}
+
+void ImmersedConstraint::solid_force(const std::vector<double>& multiplier, Vec solid_force) const {
+  const int dim = fluid_.dim;
+  if (multiplier.size() != constrained_.size() * dim)
+    throw InternalError("immersed constraint: multiplier must be constrained vertices × dim");
+  COAPT_PETSC_CHECK(VecSet(fluid_work_, 0.0));
+  PetscScalar* values = nullptr;
+  COAPT_PETSC_CHECK(VecGetArray(fluid_work_, &values));
+  for (std::size_t q = 0; q < constrained_.size(); ++q)
+    for (int i = 0; i < dim; ++i)
+      values[static_cast<std::size_t>(constrained_[q]) * dim + i] = multiplier[q * dim + i];
+  COAPT_PETSC_CHECK(VecRestoreArray(fluid_work_, &values));
+  COAPT_PETSC_CHECK(MatMultTranspose(coupling_, fluid_work_, solid_force));
+}
+
+OwnedVec ImmersedConstraint::create_solid_vector() const {
+  return fem::create_vertex_vector(*solid_, solid_->dim);
+}
+
+std::vector<double> ImmersedConstraint::sum_components(Vec solid_vector) const {
+  const int dim = solid_->dim;
+  std::vector<double> sum(static_cast<std::size_t>(dim), 0.0);
+  const PetscScalar* values = nullptr;
+  PetscInt n = 0;
+  COAPT_PETSC_CHECK(VecGetLocalSize(solid_vector, &n));
+  COAPT_PETSC_CHECK(VecGetArrayRead(solid_vector, &values));
+  for (PetscInt k = 0; k < n; ++k) sum[static_cast<std::size_t>(k % dim)] += values[k];
+  COAPT_PETSC_CHECK(VecRestoreArrayRead(solid_vector, &values));
+  MPI_Allreduce(MPI_IN_PLACE, sum.data(), dim, MPI_DOUBLE, MPI_SUM, solid_->comm);
+  return sum;
+}
+
+std::vector<double> ImmersedConstraint::sum_constrained(const std::vector<double>& values) const {
+  const int dim = fluid_.dim;
+  std::vector<double> sum(static_cast<std::size_t>(dim), 0.0);
+  for (std::size_t k = 0; k < values.size(); ++k) sum[k % dim] += values[k];
+  MPI_Allreduce(MPI_IN_PLACE, sum.data(), dim, MPI_DOUBLE, MPI_SUM, fluid_.comm);
+  return sum;
+}
+
+}  // namespace coapt::coupling

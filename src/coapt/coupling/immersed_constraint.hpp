@@ -1,0 +1,86 @@
+#pragma once
+/// @file immersed_constraint.hpp
+/// The velocity constraint between the fluid (slave) and one immersed solid (master) over
+/// their overlap, discretised with the dual mortar operators of transfer::VariationalTransfer
+/// (method/paper.md §2–3, method/notes.md "The velocity constraint in the fluid solve",
+/// "Action and reaction in the coupling"):
+///
+///   D v_f = B v_s          on the constrained fluid nodes C (D diagonal there), i.e.
+///   v_f,i = (T v_s)_i = (B v_s)_i / D_i      for i ∈ C, a Dirichlet value of the fluid solve;
+///   λ_i   = r_i / D_i                         the multiplier from the constraint reaction r_i
+///                                             (the force the fluid exerts on the constraint
+///                                             at node i, NavierStokes::constraint_reactions);
+///   f_s   = Bᵀ λ                              the nodal force of the fluid on the solid.
+///
+/// Balance: Σ_j B_ij = D_i (Σ_j φ_j = 1 on the solid), so Σ_j (f_s)_j = Σ_i λ_i D_i = Σ_i r_i
+/// component by component: the total force on the solid is minus the total constraint force
+/// on the fluid to round-off (checked by force_balance()).
+///
+/// Which fluid nodes are constrained is the transfer's covered-node rule
+/// (TransferOptions::coverage_threshold): by default those whose whole support lies in the
+/// solid, where biorthogonality makes T exact for linear fields. Vectors are interleaved
+/// vertex vectors (vertex v, component i at v·dim + i) in the PETSc layouts of the meshes.
+
+#include <petscmat.h>
+#include <petscvec.h>
+
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "coapt/core/petsc.hpp"
+#include "coapt/mesh/mesh.hpp"
+#include "coapt/transfer/operators.hpp"
+
+namespace coapt::coupling {
+
+/// The constraint between a fluid mesh and one solid mesh. Every call is collective on the
+/// meshes' communicator. Both meshes must outlive the object.
+class ImmersedConstraint {
+ public:
+  ImmersedConstraint(const mesh::Mesh& fluid, const mesh::Mesh& solid,
+                     const transfer::TransferOptions& options);
+
+  /// The solid moved (same mesh, new coordinates): re-assembles B, D and the constrained set.
+  void update_solid(const mesh::Mesh& moved);
+
+  /// Owned local fluid vertices of the constrained set, ascending.
+  const std::vector<int>& constrained_vertices() const { return constrained_; }
+  /// Number of constrained fluid vertices over all ranks.
+  PetscInt n_constrained() const { return transfer_->n_constrained(); }
+
+  /// T v_s at the constrained vertices (constrained_vertices().size() × dim, row-major) from a
+  /// solid vertex vector with dim components [m/s].
+  std::vector<double> transfer_velocity(Vec solid_velocity) const;
+  /// The same for a velocity that is the same vector at every solid node (a translating body).
+  std::vector<double> transfer_uniform_velocity(const std::vector<double>& velocity) const;
+
+  /// λ = r / D at the constrained vertices from their reactions r (same layout) [N/m³ in 3D,
+  /// N/m² in 2D].
+  std::vector<double> multiplier(const std::vector<double>& reactions) const;
+  /// f_s = Bᵀ λ into `solid_force` (a solid vertex vector with dim components, overwritten;
+  /// ghosts not updated) [N, N/m in 2D].
+  void solid_force(const std::vector<double>& multiplier, Vec solid_force) const;
+  /// A new solid vertex vector with dim components (ghosted, fem::create_vertex_vector).
+  OwnedVec create_solid_vector() const;
+
+  /// Σ over all nodes of a solid vertex vector with dim components (e.g. the total force).
+  std::vector<double> sum_components(Vec solid_vector) const;
+  /// Σ over all ranks of a constrained-vertex array (e.g. the total reaction).
+  std::vector<double> sum_constrained(const std::vector<double>& values) const;
+
+  const transfer::VariationalTransfer& transfer() const { return *transfer_; }
+
+ private:
+  void collect();
+
+  const mesh::Mesh& fluid_;
+  const mesh::Mesh* solid_;
+  std::unique_ptr<transfer::VariationalTransfer> transfer_;
+  OwnedMat coupling_;             ///< B ⊗ I_dim (MAIJ view of the transfer's B)
+  OwnedVec fluid_work_;           ///< fluid layout, dim components
+  std::vector<int> constrained_;  ///< owned local fluid vertices
+  std::vector<double> dual_;      ///< D_i at constrained_
+};
+
+}  // namespace coapt::coupling

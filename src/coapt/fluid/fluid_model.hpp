@@ -1,0 +1,203 @@
+#pragma once
+/// @file fluid_model.hpp
+/// The fluid of a case as a reusable model: it reads the fluid keys (mesh, material and
+/// Newton settings, velocity boundary conditions, outlets with their Windkessels, pressure
+/// reference) from a section of the case, loads the mesh, and steps the flow one BDF step at
+/// a time through NavierStokes. Drivers build on it: `problem: navier_stokes`
+/// (flow_problem.cpp) and the immersed coupling (coupling/), which sets a velocity constraint
+/// between Newton solves, reads its reactions and repeats a step from the same history.
+///
+/// Time stepping. The model keeps the committed history uⁿ, uⁿ⁻¹ (and the Windkessel states
+/// at tⁿ); the state vector is the trial uⁿ⁺¹:
+///
+///   model.start(0.0);                      // writes the boundary values at t = 0
+///   for each step:
+///     model.begin_step(dt);                // t = tⁿ + dt: boundary values, outlet relations
+///     ... model.solve(label) as often as the caller likes (constraint set in between) ...
+///     model.commit_step();                 // uⁿ⁻¹ ← uⁿ, uⁿ ← state, Windkessels advanced
+///   or model.restore_step();               // state ← uⁿ, time ← tⁿ (nothing committed)
+///
+/// A steady case calls solve_steady() once instead.
+
+#include <mpi.h>
+#include <petscvec.h>
+
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "coapt/core/config.hpp"
+#include "coapt/core/petsc.hpp"
+#include "coapt/fluid/navier_stokes.hpp"
+#include "coapt/io/csv_series.hpp"
+#include "coapt/io/vtk_writer.hpp"
+#include "coapt/lumped/windkessel.hpp"
+#include "coapt/mesh/mesh.hpp"
+#include "coapt/mesh/mesh_input.hpp"
+#include "coapt/mesh/quality.hpp"
+#include "coapt/run/run_output.hpp"
+
+namespace coapt::fluid {
+
+/// One entry of `boundary:`; later entries override earlier ones at shared vertices.
+struct BoundaryCondition {
+  enum class Type { velocity, no_slip, outflow };
+  enum class Profile { constant, parabolic, radial };
+  enum class Waveform { none, sinusoid, table };
+  std::string group;
+  std::string where;  ///< file:line of the entry
+  Type type = Type::no_slip;
+  Profile profile = Profile::constant;
+  std::vector<double> value;     ///< velocity (peak for parabolic) [m/s]
+  std::vector<double> from, to;  ///< parabolic: the two ends of the profile [m]
+  double ramp_time = 0;          ///< > 0: value × (1 − cos(π min(t/T, 1)))/2 [s]
+  std::vector<double> centre;    ///< radial: the axis point of the inlet plane [m]
+  double radius = 0;             ///< radial: value × (1 − r²/radius²) [m]
+  Waveform waveform = Waveform::none;
+  double amplitude = 0;                ///< sinusoid: value × (1 + a sin(2πt/T))
+  double period = 0;                   ///< sinusoid, table: T [s] (table: 0 = not periodic)
+  std::vector<double> times, factors;  ///< table: value × factor(t), linear in between
+};
+
+/// An entry of `outlets:`: the pressure on a facet group, fixed or from a Windkessel.
+struct OutletCondition {
+  enum class Type { do_nothing, traction, windkessel };
+  std::string group;
+  std::string where;
+  Type type = Type::do_nothing;
+  double pressure = 0;  ///< traction: P [Pa]
+  lumped::WindkesselParameters windkessel;
+  double backflow = 0;  ///< β
+};
+
+/// The fluid keys of a case, read once.
+struct FluidCase {
+  mesh::MeshInput mesh;
+  FluidParameters fluid;
+  std::vector<BoundaryCondition> boundary;
+  std::vector<OutletCondition> outlets;
+  bool has_pressure_reference = false;
+  std::vector<double> pressure_reference;  ///< the vertex nearest to it gets p = 0
+
+  /// Reads `mesh`, `boundary`, `outlets`, `pressure_reference` from `section` and the
+  /// material and Newton keys (density, viscosity, convection, c_inverse, newton) from
+  /// `properties` (the same section, or a sub-section such as `fluid` of the root).
+  static FluidCase read(const config::Section& section, const config::Section& properties);
+};
+
+/// The `time` section: steady, or BDF steps of a fixed size up to end_time.
+struct TimeSettings {
+  bool steady = true;
+  double end_time = 0;   ///< [s]
+  double time_step = 0;  ///< [s]
+  /// Reads `time` (steady, end_time, step) from `root`.
+  static TimeSettings read(const config::Section& root);
+  /// Number of steps to reach end_time (the last one may be shorter).
+  int n_steps() const;
+};
+
+/// Adds `levels` refinement levels to a mesh input (geo sizes and generator cell counts halve
+/// per level); InputError naming `where` for a mesh read from a .msh file, which cannot be
+/// refined.
+void add_refinement_levels(mesh::MeshInput& input, int levels, const std::string& where);
+
+/// Values of component `component` of a vertex vector with `n_components` per vertex at
+/// `points` (n × dim, row-major), each from the owned cell that contains it (NaN where none
+/// does; the lowest rank's value on partition boundaries). Collective.
+std::vector<double> values_at(const mesh::Mesh& mesh, Vec vector, int n_components, int component,
+                              const std::vector<double>& points);
+
+/// The fluid of a case. Every call is collective on the mesh's communicator unless noted.
+class FluidModel {
+ public:
+  /// Loads and distributes the mesh and checks the groups the case names (InputError naming
+  /// the entry). `level_offset` is added to the mesh's refinement level.
+  FluidModel(FluidCase parameters, MPI_Comm comm, int level_offset = 0);
+  FluidModel(const FluidModel&) = delete;
+  FluidModel& operator=(const FluidModel&) = delete;
+  ~FluidModel();
+
+  const FluidCase& parameters() const { return parameters_; }
+  const mesh::Mesh& mesh() const { return mesh_; }
+  MPI_Comm comm() const { return comm_; }
+  /// Logs the mesh, its quality and the material. Not collective (rank 0 logs).
+  void describe(const std::string& title) const;
+
+  /// Facet tag of the boundary group `name`; InputError naming `key` and the groups there are.
+  int boundary_tag(const std::string& name, const std::string& key) const;
+
+  /// Creates the operator, Dirichlet dofs and outlets, and writes the boundary values at
+  /// `time` into the state (the initial condition uⁿ = u⁰; transient runs).
+  void start(double time = 0.0);
+  /// The operator (after start()).
+  NavierStokes& navier_stokes() { return *fluid_; }
+  /// The state (u, p interleaved, ghosted; the trial uⁿ⁺¹ during a step).
+  Vec state() const { return fluid_->state(); }
+  /// The time level of the current solve (steady: time_step 0).
+  const TimeLevel& level() const { return level_; }
+  /// Time of the trial state [s] (tⁿ⁺¹ during a step, tⁿ after commit/restore).
+  double time() const { return time_; }
+  /// Steps committed so far.
+  int steps() const { return steps_; }
+
+  /// Steady problem: boundary values at t = ∞, steady outlet resistances, Newton solve.
+  NewtonReport solve_steady(const std::string& label);
+  /// Starts a step of size dt from the committed state: time tⁿ + dt, BDF1 on the first step
+  /// and BDF2 after, boundary values and outlet relations at the new time.
+  void begin_step(double dt);
+  /// Newton solve of the current step (or steady problem); throws ConvergenceError.
+  NewtonReport solve(const std::string& label);
+  /// Accepts the trial state: history shift, Windkessels advanced with the outlet flows.
+  void commit_step();
+  /// Drops the trial state: state ← uⁿ, time ← tⁿ, Windkessels untouched.
+  void restore_step();
+
+  /// Constrains the velocity at owned local vertices (vertices.size() × dim velocities, row
+  /// major) [m/s] for the following solves (NavierStokes::set_velocity_constraint).
+  void set_velocity_constraint(std::span<const int> vertices, std::span<const double> velocities);
+  /// The force the fluid exerts on the constraint at each constrained vertex (same layout)
+  /// at the current state [N/m in 2D, N in 3D].
+  std::vector<double> constraint_reactions();
+  /// Force of the fluid on the boundary group with facet tag `tag` at the current state.
+  std::vector<double> boundary_force(int tag);
+
+  /// Outlet k's flow Q and pressure P at the current state.
+  double outlet_flow(std::size_t k) const { return fluid_->outlet_flow(k); }
+  double outlet_pressure(std::size_t k) const { return fluid_->outlet_pressure(k); }
+  /// The Windkessel state of outlet k (null when it has none) for a summary or a restart.
+  const lumped::Windkessel* windkessel(std::size_t k) const { return windkessels_[k].get(); }
+  /// Series columns: flow_<group> of each velocity group, outlet_flow_<group> and
+  /// outlet_pressure_<group> of each outlet.
+  void record_flows(io::CsvSeries& series) const;
+  /// Writes `windkessel_state` (per outlet group) into the summary.
+  void write_windkessel_states(run::RunOutput& output) const;
+  /// Kinetic energy ½ ∫ ρ |u|² of the current state (lumped P1 mass) [J/m in 2D, J].
+  double kinetic_energy() const;
+  /// Velocity and pressure (and `extra` fields of this mesh) as VTK (series `name`) at `time`.
+  void write_vtk(run::RunOutput& output, double time, const std::vector<io::Field>& extra = {},
+                 const std::string& name = "solution") const;
+
+ private:
+  void setup_dirichlet();
+  void setup_outlets();
+  void set_outlet_pressures(double dt);
+  void write_boundary_values(double time);
+  std::string boundary_group_names() const;
+
+  const FluidCase parameters_;
+  MPI_Comm comm_;
+  mesh::QualityReport quality_;
+  mesh::Mesh mesh_;
+  std::vector<int> tags_;                 ///< facet tag of each boundary entry
+  std::vector<int> outlet_tags_;          ///< facet tag of each outlet entry
+  std::vector<int> condition_of_vertex_;  ///< per owned vertex: the boundary entry, or −1
+  std::unique_ptr<NavierStokes> fluid_;
+  std::vector<std::unique_ptr<lumped::Windkessel>> windkessels_;  ///< per outlet, or null
+  OwnedVec previous_, before_;                                    ///< committed uⁿ, uⁿ⁻¹
+  TimeLevel level_;
+  double time_ = 0, committed_time_ = 0, last_step_ = 0;
+  int steps_ = 0;
+};
+
+}  // namespace coapt::fluid
