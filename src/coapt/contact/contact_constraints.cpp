@@ -119,13 +119,8 @@ void ContactConstraints::update(Vec u, Vec residual) {
     position(pair.slave, *slave_gathers_[p], pair.slave_x);
     position(pair.master, *master_gathers_[p], pair.master_x);
     slave_gathers_[p]->gather(residual, force);
-    MortarOptions options;
-    options.search_distance = parameters_.search_distance > 0.0 ? parameters_.search_distance
-                                                                : 10.0 * reference_sizes_[p];
-    options.coverage_threshold = parameters_.coverage_threshold;
-    options.boundary_modification = parameters_.boundary_modification;
-    options.fixed_components = pair.dirichlet;
-    pair.mortar = assemble_mortar(pair.slave, pair.slave_x, pair.master, pair.master_x, options);
+    pair.mortar =
+        assemble_mortar(pair.slave, pair.slave_x, pair.master, pair.master_x, mortar_options(p));
     const double tolerance = parameters_.relative_gap_tolerance * reference_sizes_[p];
     status.gap_tolerance = std::max(status.gap_tolerance, tolerance);
     const auto& m = pair.mortar;
@@ -190,6 +185,65 @@ void ContactConstraints::update(Vec u, Vec residual) {
   COAPT_PETSC_CHECK(VecAssemblyBegin(work_));
   COAPT_PETSC_CHECK(VecAssemblyEnd(work_));
   COAPT_PETSC_CHECK(VecCopy(work_, residual));
+}
+
+MortarOptions ContactConstraints::mortar_options(std::size_t p) const {
+  MortarOptions options;
+  options.search_distance =
+      parameters_.search_distance > 0.0 ? parameters_.search_distance : 10.0 * reference_sizes_[p];
+  options.coverage_threshold = parameters_.coverage_threshold;
+  options.boundary_modification = parameters_.boundary_modification;
+  options.fixed_components = pairs_[p].dirichlet;
+  return options;
+}
+
+int ContactConstraints::project_predictor(Vec u, Vec increment) {
+  // With a lumped mass and node-wise normal coordinates the projection of uₙ + δ onto the
+  // admissible set in the mass norm is a node-wise clip of the normal components (refs §6.1:
+  // pred = O min(Oᵀ δ, g)). For slave node j the predicted gap is
+  //   g_j' = g_j + n_j · (m_j − δ_j),  m_j = Σ_l M_jl δ_l / D_jj,
+  // the mortar projection of the master's increment; where g_j' < 0 the slave's increment
+  // loses its penetrating normal part: δ_j ← δ_j + g_j' n_j, so g_j' becomes 0. The master's
+  // increment is kept (exact for a fixed master; with two deformable bodies the projection
+  // is a small quadratic program, method/notes.md, which this node-wise clip approximates).
+  std::vector<double> displacement, slave_increment, master_increment;
+  int clipped = 0;
+  for (std::size_t p = 0; p < pairs_.size(); ++p) {
+    const auto& pair = pairs_[p];
+    std::vector<double> slave_x = pair.slave.reference, master_x = pair.master.reference;
+    slave_gathers_[p]->gather(u, displacement);
+    for (std::size_t k = 0; k < slave_x.size(); ++k) slave_x[k] += displacement[k];
+    master_gathers_[p]->gather(u, displacement);
+    for (std::size_t k = 0; k < master_x.size(); ++k) master_x[k] += displacement[k];
+    slave_gathers_[p]->gather(increment, slave_increment);
+    master_gathers_[p]->gather(increment, master_increment);
+    const auto m = assemble_mortar(pair.slave, slave_x, pair.master, master_x, mortar_options(p));
+    std::vector<double> projected(static_cast<std::size_t>(pair.slave.n_nodes()) * dim_, 0.0);
+    for (const auto& e : m.master_coupling)
+      for (int i = 0; i < dim_; ++i)
+        projected[static_cast<std::size_t>(e.row) * dim_ + i] +=
+            e.value * master_increment[static_cast<std::size_t>(e.column) * dim_ + i];
+    for (int j = 0; j < pair.slave.n_nodes(); ++j) {
+      if (!m.constrained(j)) continue;
+      double closing = 0.0;
+      for (int i = 0; i < dim_; ++i) {
+        const std::size_t k = static_cast<std::size_t>(j) * dim_ + i;
+        closing += m.normals[k] * (slave_increment[k] - projected[k] / m.dual_mass[j]);
+      }
+      const double gap = m.gap(j) - closing;
+      if (gap >= 0.0) continue;
+      ++clipped;
+      for (int i = 0; i < dim_; ++i) {
+        const std::size_t k = static_cast<std::size_t>(j) * dim_ + i;
+        const PetscInt dof = pair.slave.global_vertex[j] * dim_ + i;
+        if (dof < first_dof_ || dof >= end_dof_ || pair.dirichlet[k]) continue;
+        COAPT_PETSC_CHECK(VecSetValue(increment, dof, gap * m.normals[k], ADD_VALUES));
+      }
+    }
+  }
+  COAPT_PETSC_CHECK(VecAssemblyBegin(increment));
+  COAPT_PETSC_CHECK(VecAssemblyEnd(increment));
+  return clipped;
 }
 
 void ContactConstraints::build_row_operator() {

@@ -95,6 +95,11 @@ class ContactConstraints {
   /// rhs ← P rhs + c n g̃ on A, for K Δu = rhs = −R after the solid's Dirichlet treatment.
   /// Collective.
   Mat transform(Mat K, Vec rhs);
+  /// Contact-stabilized Newmark predictor: clips the normal part of the increment δ (a
+  /// displacement-layout vector, owned entries) at every slave node that uₙ + δ would push
+  /// through its master (mortar operators at the displacement u = uₙ); returns the number of
+  /// slave nodes clipped. Collective.
+  int project_predictor(Vec u, Vec increment);
   /// Forgets the previous active set's change count (a new step). Not collective.
   void begin_step() { settled_updates_ = 0; }
 
@@ -109,6 +114,8 @@ class ContactConstraints {
 
  private:
   void build_row_operator();
+  /// The mortar search and integration options of pair p.
+  MortarOptions mortar_options(std::size_t p) const;
 
   ContactParameters parameters_;
   const mesh::Mesh& mesh_;

@@ -135,6 +135,11 @@ bool ContactHook::accept(Vec u) {
   return false;
 }
 
+void ContactHook::project_predictor(Vec u, Vec increment) {
+  const int clipped = constraints_.project_predictor(u, increment);
+  if (clipped > 0) log::debug("contact: the predictor was clipped at {} slave node(s)", clipped);
+}
+
 std::vector<io::Field> ContactHook::fields() {
   constraints_.vertex_fields(pressure_, gap_, active_);
   return {{"contact_pressure", 1, io::Field::Location::vertex, pressure_},

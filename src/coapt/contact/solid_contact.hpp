@@ -82,6 +82,7 @@ class ContactHook final : public solid::NewtonHook {
   void add_residual(Vec u, Vec residual) override;
   Mat linear_system(Vec u, Mat K, Vec rhs) override;
   bool accept(Vec u) override;
+  void project_predictor(Vec u, Vec increment) override;
 
   const ContactConstraints& constraints() const { return constraints_; }
   /// The contact fields for SolidModel::write_vtk (pressure, gap, active set).

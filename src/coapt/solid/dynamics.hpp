@@ -13,9 +13,12 @@
 ///    E = ½ vᵀMv + ½ uᵀKu − f_extᵀu exactly: E_{n+1} − E_n = ½ (u_{n+1} − u_n)ᵀ(r_n + r_{n+1})
 ///    with r the residual of the equation of motion, which is zero at each converged step.
 ///  - the summary of an oscillating signal over its last full period (mean, amplitude,
-///    frequency), as reported for the unsteady Turek–Hron cases.
+///    frequency), as reported for the unsteady Turek–Hron cases;
+///  - the impacts of a body seen in a time series (rebound angles and energy loss, as in the
+///    ball-in-a-box benchmark of method/paper.md §3.1).
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -124,6 +127,65 @@ inline OscillationSummary last_period(std::span<const double> t, std::span<const
   summary.amplitude = 0.5 * (high - low);
   summary.frequency = 1.0 / (crossings.back() - crossings[crossings.size() - 2]);
   return summary;
+}
+
+/// One impact of a body: the steps [start, end) in contact, the angles of the barycentre
+/// velocity with the wall before and after it, and the total energy around it.
+struct Impact {
+  double start_time = 0;       ///< first time in contact [s]
+  double end_time = 0;         ///< first time out of contact again [s]
+  double incidence_angle = 0;  ///< angle of the velocity before, with the wall [degrees]
+  double rebound_angle = 0;    ///< angle of the velocity after, with the wall [degrees]
+  double energy_before = 0;    ///< total energy at the last step before contact
+  double energy_after = 0;     ///< total energy at the first step after contact
+  double energy_loss = 0;      ///< (before − after) / |before| (negative: energy gained)
+};
+
+/// The impacts in a time series: each run of samples with `in_contact` set, preceded and
+/// followed by a sample out of contact (a contact still open at the end, or present from the
+/// first sample, is not an impact). The wall's normal is taken as the direction of the
+/// velocity change v_after − v_before (a frictionless wall pushes only along its normal), and
+/// each angle with the wall is asin(|v · n̂| / |v|): 45° in and out for the diamond of the
+/// ball in a box. An impact that does not change the velocity is skipped.
+inline std::vector<Impact> find_impacts(std::span<const double> times,
+                                        std::span<const char> in_contact,
+                                        std::span<const std::array<double, 3>> velocity,
+                                        std::span<const double> energy) {
+  constexpr double kDegrees = 180.0 / 3.14159265358979323846;
+  const auto dot = [](const std::array<double, 3>& a, const std::array<double, 3>& b) {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  };
+  const auto angle = [&](const std::array<double, 3>& v, const std::array<double, 3>& n) {
+    const double speed = std::sqrt(dot(v, v));
+    return speed > 0 ? std::asin(std::min(1.0, std::abs(dot(v, n)) / speed)) * kDegrees : 0.0;
+  };
+  std::vector<Impact> impacts;
+  const std::size_t n = times.size();
+  for (std::size_t start = 1; start < n; ++start) {
+    if (!in_contact[start] || in_contact[start - 1]) continue;
+    std::size_t end = start;
+    while (end < n && in_contact[end]) ++end;
+    if (end == n) break;
+    const auto& before = velocity[start - 1];
+    const auto& after = velocity[end];
+    std::array<double, 3> normal{after[0] - before[0], after[1] - before[1], after[2] - before[2]};
+    const double size = std::sqrt(dot(normal, normal));
+    if (size > 0) {
+      for (double& x : normal) x /= size;
+      Impact impact;
+      impact.start_time = times[start];
+      impact.end_time = times[end];
+      impact.incidence_angle = angle(before, normal);
+      impact.rebound_angle = angle(after, normal);
+      impact.energy_before = energy[start - 1];
+      impact.energy_after = energy[end];
+      impact.energy_loss = (impact.energy_before - impact.energy_after) /
+                           std::max(std::abs(impact.energy_before), 1e-300);
+      impacts.push_back(impact);
+    }
+    start = end;
+  }
+  return impacts;
 }
 
 }  // namespace coapt::solid

@@ -106,6 +106,9 @@ class SolidModelImpl {
         external_(fem::create_vertex_vector(mesh_, dim_)),
         residual_(fem::create_vertex_vector(mesh_, dim_)),
         inertia_(fem::create_vertex_vector(mesh_, dim_)),
+        predictor_(fem::create_vertex_vector(mesh_, dim_)),
+        static_residual_(fem::create_vertex_vector(mesh_, dim_)),
+        work_(fem::create_vertex_vector(mesh_, dim_)),
         matrix_(mesh_, dim_),
         solver_(comm_, "solid_",
                 // Quasi-static: GMRES rather than CG (the tangent is symmetric but loses
@@ -160,7 +163,9 @@ class SolidModelImpl {
     if (density_offset_ != 0)
       log::info("inertia density: body density - {:g} kg/m^3", density_offset_);
     if (parameters_.time.dynamic)
-      log::info("Newmark (beta 1/4, gamma 1/2): {} steps of {:g} s to t = {:g} s",
+      log::info("{} (beta 1/4, gamma 1/2): {} steps of {:g} s to t = {:g} s",
+                parameters_.time.contact_stabilized ? "contact-stabilized Newmark, lumped mass"
+                                                    : "Newmark, consistent mass",
                 parameters_.time.n_steps, parameters_.time.step, parameters_.time.end_time);
     else
       log::info("{} load step(s)", parameters_.steps);
@@ -253,10 +258,21 @@ class SolidModelImpl {
     COAPT_PETSC_CHECK(VecSet(u_, 0.0));
     set_dirichlet(u_, 1.0);
     fem::update_ghosts(u_);
-    {
-      const auto& initial = parameters_.time.initial_velocity;
+    {  // each vertex takes the initial velocity of the first body it belongs to
+      std::vector<int> first_body(static_cast<std::size_t>(mesh_.n_vertices()),
+                                  static_cast<int>(parameters_.bodies.size()));
+      for (int c = 0; c < mesh_.n_cells(); ++c)
+        for (const int vertex : mesh_.cell(c))
+          first_body[vertex] = std::min(first_body[vertex], body_of_cell_[c]);
       WriteArray v(v_);
-      for_each_owned(v_, [&](PetscInt k) { v[k] = initial.empty() ? 0.0 : initial[k % dim_]; });
+      for_each_owned(v_, [&](PetscInt k) {
+        const int b = first_body[static_cast<std::size_t>(k / dim_)];
+        const auto& own = b < static_cast<int>(parameters_.bodies.size())
+                              ? parameters_.bodies[b].initial_velocity
+                              : parameters_.time.initial_velocity;
+        const auto& initial = own.empty() ? parameters_.time.initial_velocity : own;
+        v[k] = initial.empty() ? 0.0 : initial[k % dim_];
+      });
     }
     zero_dirichlet(v_);
     fem::update_ghosts(v_);
@@ -289,7 +305,15 @@ class SolidModelImpl {
     if (!mass_) throw InternalError("solid: step() before initialize_dynamics()");
     const Newmark scheme{time_step};
     const std::string label = fmt::format("time step to t = {:g} s", time);
-    {  // predictor u = uₙ + Δt vₙ + Δt²/2 aₙ (Dirichlet dofs: v = a = 0, u stays)
+    if (parameters_.time.contact_stabilized) {
+      // Contact-stabilized predictor: the increment δ = Δt vₙ, projected by the hook onto
+      // the admissible set (no penetration at uₙ + δ); Newton starts from uₙ + δ.
+      COAPT_PETSC_CHECK(VecCopy(v_committed_, predictor_));
+      COAPT_PETSC_CHECK(VecScale(predictor_, time_step));
+      zero_dirichlet(predictor_);
+      if (hook_) hook_->project_predictor(u_committed_, predictor_);
+      COAPT_PETSC_CHECK(VecWAXPY(u_, 1.0, predictor_, u_committed_));
+    } else {  // predictor u = uₙ + Δt vₙ + Δt²/2 aₙ (Dirichlet dofs: v = a = 0, u stays)
       WriteArray u(u_);
       ReadArray un(u_committed_), vn(v_committed_), an(a_committed_);
       for_each_owned(u_, [&](PetscInt k) { u[k] = scheme.predictor(un[k], vn[k], an[k]); });
@@ -326,6 +350,19 @@ class SolidModelImpl {
     COAPT_PETSC_CHECK(VecCopy(u_, u_committed_));
     COAPT_PETSC_CHECK(VecCopy(v_, v_committed_));
     COAPT_PETSC_CHECK(VecCopy(a_, a_committed_));
+    if (parameters_.time.contact_stabilized) commit_static_residual();
+  }
+
+  /// Contact-stabilized Newmark: Rₙ = f_int(uₙ) − f_ext − f_extra at the committed state,
+  /// without the hook's (contact) terms, for the next step's inertia term (update_acceleration).
+  void commit_static_residual() {
+    NewtonHook* hook = hook_;
+    hook_ = nullptr;
+    const double norm = assemble_residual(u_committed_, 1.0, nullptr);
+    hook_ = hook;
+    if (!std::isfinite(norm))
+      throw ConvergenceError("solid: the committed state has an inverted cell");
+    COAPT_PETSC_CHECK(VecCopy(residual_, static_residual_));
   }
 
   void restore() {
@@ -348,6 +385,7 @@ class SolidModelImpl {
     reader.read_vertex_field(prefix + "v", mesh_, v_committed_, dim_);
     reader.read_vertex_field(prefix + "a", mesh_, a_committed_, dim_);
     restore();
+    if (parameters_.time.contact_stabilized) commit_static_residual();
   }
 
   // --- reported quantities --------------------------------------------------------------------
@@ -391,6 +429,52 @@ class SolidModelImpl {
 
   double volume() const {
     return dim_ == 2 ? cell_integral<2>(Integrand::volume) : cell_integral<3>(Integrand::volume);
+  }
+
+  std::vector<BodyMotion> body_motion() const {
+    const std::size_t n_bodies = parameters_.bodies.size();
+    // per body: mass, Σ m x (3), Σ m v (3), Σ m x × v (3)
+    std::vector<double> sums(n_bodies * 10, 0.0);
+    fem::LocalValues u(u_.get()), v(v_.get());
+    const double share = 1.0 / (dim_ + 1);
+    for (int c = 0; c < mesh_.n_cells(); ++c) {
+      const int b = body_of_cell_[c];
+      const double measure = dim_ == 2 ? geometry<2>(c).measure : geometry<3>(c).measure;
+      const double m = parameters_.bodies[b].density * measure * share;
+      for (const int vertex : mesh_.cell(c)) {
+        if (vertex >= mesh_.n_owned_vertices) continue;  // ghost: its owner adds it
+        std::array<double, 3> x{}, w{};
+        for (int i = 0; i < dim_; ++i) {
+          const std::size_t k = static_cast<std::size_t>(vertex) * dim_ + i;
+          x[i] = mesh_.coordinates[k] + u[k];
+          w[i] = v[k];
+        }
+        double* sum = &sums[static_cast<std::size_t>(b) * 10];
+        sum[0] += m;
+        for (int i = 0; i < 3; ++i) {
+          sum[1 + i] += m * x[i];
+          sum[4 + i] += m * w[i];
+        }
+        sum[7] += m * (x[1] * w[2] - x[2] * w[1]);
+        sum[8] += m * (x[2] * w[0] - x[0] * w[2]);
+        sum[9] += m * (x[0] * w[1] - x[1] * w[0]);
+      }
+    }
+    MPI_Allreduce(MPI_IN_PLACE, sums.data(), static_cast<int>(sums.size()), MPI_DOUBLE, MPI_SUM,
+                  comm_);
+    std::vector<BodyMotion> motions(n_bodies);
+    for (std::size_t b = 0; b < n_bodies; ++b) {
+      const double* sum = &sums[b * 10];
+      auto& motion = motions[b];
+      motion.name = parameters_.bodies[b].name;
+      motion.mass = sum[0];
+      for (int i = 0; i < 3; ++i) {
+        motion.barycentre[i] = sum[0] > 0 ? sum[1 + i] / sum[0] : 0.0;
+        motion.momentum[i] = sum[4 + i];
+        motion.angular_momentum[i] = sum[7 + i];
+      }
+    }
+    return motions;
   }
 
   std::vector<double> current_coordinates() const {
@@ -1121,25 +1205,45 @@ class SolidModelImpl {
       add_element_mass<3>(c, scale * density, element);
   }
 
+  /// Contact-stabilized Newmark lumps the mass by rows (|c|/(Dim+1) per vertex), so that the
+  /// projection of its predictor in the mass norm is node-wise.
   template <int Dim>
   void add_element_mass(int c, double factor, double* element) const {
     constexpr int n = (Dim + 1) * Dim;
     const auto mass = fem::element_mass<Dim>(geometry<Dim>(c));
+    const bool lumped = parameters_.time.contact_stabilized;
     for (int a = 0; a <= Dim; ++a)
       for (int b = 0; b <= Dim; ++b)
-        for (int i = 0; i < Dim; ++i)
-          element[(a * Dim + i) * n + b * Dim + i] += factor * mass(a, b);
+        for (int i = 0; i < Dim; ++i) {
+          const int column = lumped ? a : b;
+          element[(a * Dim + i) * n + column * Dim + i] += factor * mass(a, b);
+        }
   }
 
-  /// a(u) into a_ and M a(u) into inertia_, from u_ and the committed state.
+  /// a(u) into a_ and the inertia term into inertia_, from u_ and the committed state.
+  /// Newmark: M a(u), a(u) = 4/Δt² (u − uₙ − Δt vₙ) − aₙ. Contact-stabilized Newmark
+  /// (Deuflhard, Krause, Ertel 2008; method/notes.md): Δt vₙ is replaced by the projected
+  /// predictor δ and M aₙ by f_ext − f_int(uₙ) without the contact force of step n, i.e. the
+  /// term 4/Δt² M (u − uₙ − δ) + Rₙ, so that the step solves
+  ///   4/Δt² M (u − uₙ − δ) + f_int(u) + f_int(uₙ) − 2 f_ext + contact = 0,
+  /// and a(u) = 4/Δt² (u − uₙ − δ) − aₙ keeps v = vₙ + Δt/2 (aₙ + a) = vₙ + 2/Δt (u − uₙ − δ).
   void update_acceleration(const Newmark& scheme) {
+    const bool stabilized = parameters_.time.contact_stabilized;
     {
       WriteArray a(a_);
-      ReadArray u(u_), un(u_committed_), vn(v_committed_), an(a_committed_);
-      for_each_owned(a_,
-                     [&](PetscInt k) { a[k] = scheme.acceleration(u[k], un[k], vn[k], an[k]); });
+      ReadArray u(u_), un(u_committed_), vn(v_committed_), an(a_committed_), d(predictor_);
+      for_each_owned(a_, [&](PetscInt k) {
+        const double v = stabilized ? d[k] / scheme.step : vn[k];
+        a[k] = scheme.acceleration(u[k], un[k], v, an[k]);
+      });
     }
-    COAPT_PETSC_CHECK(MatMult(mass_->mat(), a_, inertia_));
+    if (!stabilized) {
+      COAPT_PETSC_CHECK(MatMult(mass_->mat(), a_, inertia_));
+      return;
+    }
+    COAPT_PETSC_CHECK(VecWAXPY(work_, 1.0, a_, a_committed_));  // 4/Δt² (u − uₙ − δ)
+    COAPT_PETSC_CHECK(MatMult(mass_->mat(), work_, inertia_));
+    COAPT_PETSC_CHECK(VecAXPY(inertia_, 1.0, static_residual_));
   }
 
   enum class Integrand { energy, volume };
@@ -1322,6 +1426,8 @@ class SolidModelImpl {
   OwnedVec u_committed_, v_committed_, a_committed_;  ///< uₙ, vₙ, aₙ
   OwnedVec external_;                                 ///< f_ext at load factor 1
   OwnedVec residual_, inertia_;
+  // contact-stabilized Newmark: the projected predictor increment δ, Rₙ, a work vector
+  OwnedVec predictor_, static_residual_, work_;
   fem::P1Matrix matrix_;
   std::optional<fem::P1Matrix> mass_;  ///< inertia-density mass (dynamics only)
   fem::LinearSolver solver_;
@@ -1402,6 +1508,9 @@ void SolidModel::read_checkpoint(const run::CheckpointReader& reader, const std:
 }
 std::vector<std::vector<double>> SolidModel::probe_values() const {
   return impl_->probe_values();
+}
+std::vector<BodyMotion> SolidModel::body_motion() const {
+  return impl_->body_motion();
 }
 double SolidModel::kinetic_energy() const {
   return impl_->kinetic_energy();

@@ -74,6 +74,23 @@ class NewtonHook {
     (void)u;
     return true;
   }
+  /// Contact-stabilized Newmark, once per step before begin_step: projects the predictor
+  /// increment δ (owned entries; Δt vₙ on entry) from the committed displacement `u` onto
+  /// the admissible set, in place.
+  virtual void project_predictor(Vec u, Vec increment) {
+    (void)u;
+    (void)increment;
+  }
+};
+
+/// Mass, barycentre and momenta of one body in the current configuration, from the row-sum
+/// lumped mass with the body's full density (ρ |c|/(Dim+1) per vertex of each cell c):
+/// x̄ = Σ m_a x_a / Σ m_a, p = Σ m_a v_a, L = Σ m_a x_a × v_a about the origin (2D: only the
+/// z component is non-zero). Units: kg (kg/m in 2D), m, kg m/s, kg m²/s.
+struct BodyMotion {
+  std::string name;
+  double mass = 0;
+  std::array<double, 3> barycentre{}, momentum{}, angular_momentum{};
 };
 
 /// What one load step or time step did.
@@ -156,6 +173,9 @@ class SolidModel {
   double external_work() const;
   /// Current volume ∫ det F dX [m³, or m² in 2D].
   double volume() const;
+  /// Mass, barycentre and momenta of every body (BodyMotion; the same on every rank).
+  /// Collective.
+  std::vector<BodyMotion> body_motion() const;
   /// Volume averages over the bodies: ∫ F dX / ∫ dX and ∫ σ dx / ∫ dx (current volume),
   /// 3×3 row-major (F₃₃ = 1 and σ₃₃ included in plane strain).
   std::array<double, 9> mean_deformation_gradient() const;

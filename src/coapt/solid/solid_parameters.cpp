@@ -117,6 +117,10 @@ SolidParameters SolidParameters::read(const config::Section& root) {
     body.density = section.get<double>("density", 0.0,
                                        {"kg/m^3", "reference density", Bounds::non_negative()});
     body.material = read_material(section.section("material", "constitutive law"));
+    body.initial_velocity = section.get<std::vector<double>>(
+        "initial_velocity", {},
+        {"m/s",
+         "dynamics: initial velocity of the body's free dofs (empty: time.initial_velocity)"});
     if (const auto* fibre_law = std::get_if<FibreReinforced>(&body.material)) {
       body.fibre_field = FibreFieldParameters::read(section, fibre_law->n_fibre_families);
       if (body.fibre_field.rule == FibreFieldParameters::Rule::constant) {
@@ -188,9 +192,14 @@ SolidParameters SolidParameters::read(const config::Section& root) {
 
   auto time = root.section("time", "time integration (static load stepping or Newmark)");
   p.time.where = located(time);
-  p.time.dynamic =
-      time.choice("scheme", "static", {"static", "newmark"},
-                  {"", "static: load steps; newmark: dynamics, beta 1/4, gamma 1/2"}) == "newmark";
+  const auto scheme = time.choice(
+      "scheme", "static", {"static", "newmark", "contact_stabilized_newmark"},
+      {"",
+       "static: load steps; newmark: dynamics, beta 1/4, gamma 1/2; "
+       "contact_stabilized_newmark: Newmark with lumped mass and the predictor projected onto "
+       "the admissible set (Deuflhard-Krause-Ertel)"});
+  p.time.dynamic = scheme != "static";
+  p.time.contact_stabilized = scheme == "contact_stabilized_newmark";
   if (p.time.dynamic) {
     p.time.step = time.require<double>("step", {"s", "time step", Bounds::positive()});
     p.time.end_time = time.require<double>("end_time", {"s", "final time", Bounds::positive()});
@@ -310,6 +319,9 @@ void SolidParameters::check_dimension(int dim) const {
   if (!gravity.empty()) check(gravity.size(), gravity_where, "gravity");
   if (!time.initial_velocity.empty())
     check(time.initial_velocity.size(), time.where + ".initial_velocity", "initial_velocity");
+  for (const auto& body : bodies)
+    if (!body.initial_velocity.empty())
+      check(body.initial_velocity.size(), body.where + ".initial_velocity", "initial_velocity");
   for (const auto& probe : probes) check(probe.point.size(), probe.where, "point");
   if (dim == 2)
     for (const auto& body : bodies)

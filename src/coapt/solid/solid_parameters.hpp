@@ -22,7 +22,11 @@
 ///   formulation: displacement          or mixed (P1-P1 u-p, nearly incompressible laws)
 ///   steps: 10                          load steps (load factor k/steps; static only)
 ///   time: {scheme: newmark, step: 0.005, end_time: 10, initial_velocity: [0, 0.1]}
-///                                      dynamics (dynamics.hpp); scheme: static (default)
+///                                      dynamics (dynamics.hpp); scheme: static (default),
+///                                      newmark or contact_stabilized_newmark;
+///                                      bodies[].initial_velocity overrides it per body
+///   impacts: {body: ball}              dynamics with contact: rebound angles and energy loss
+///                                      of each impact of that body (solid_problem.cpp)
 ///   newton: {relative_tolerance, absolute_tolerance, update_tolerance, max_iterations}
 ///   probes: [{name: tip, point: [0.048, 0.060]}]
 ///   uniaxial_reference: {axis: [1, 0, 0], reaction_boundary: right, reference_area: 1e-6}
@@ -48,7 +52,10 @@ struct BodyParameters {
   Material material;
   FibreDirections fibres;            ///< fibre_reinforced with a constant rule: the directions
   FibreFieldParameters fibre_field;  ///< fibre_reinforced: how the directions are given
-  std::string where;                 ///< location in the case file, for messages
+  /// Dynamics: the initial velocity of this body's free dofs [m/s] (empty: time's
+  /// initial_velocity). A vertex shared by two bodies takes the first body's.
+  std::vector<double> initial_velocity;
+  std::string where;  ///< location in the case file, for messages
 };
 
 /// Prescribed displacement of some components on a boundary group (ramped with the load).
@@ -91,11 +98,14 @@ struct NewtonParameters {
   int max_iterations = 25;
 };
 
-/// Time integration: `static` (load stepping, the default) or `newmark` (β = 1/4, γ = 1/2)
-/// from u = 0 (Dirichlet values from t = 0), a uniform initial velocity on the free dofs and
-/// the loads applied in full at t = 0.
+/// Time integration: `static` (load stepping, the default), `newmark` (β = 1/4, γ = 1/2) or
+/// `contact_stabilized_newmark` (Deuflhard, Krause and Ertel 2008: lumped mass, the predictor
+/// projected onto the admissible set by the contact hook, the contact force of step n left
+/// out of step n+1; dynamics.hpp), from u = 0 (Dirichlet values from t = 0), the initial
+/// velocities on the free dofs and the loads applied in full at t = 0.
 struct TimeParameters {
   bool dynamic = false;
+  bool contact_stabilized = false;       ///< scheme contact_stabilized_newmark (dynamic too)
   double step = 0;                       ///< Δt [s]
   double end_time = 0;                   ///< [s]
   int n_steps = 0;                       ///< round(end_time/Δt)

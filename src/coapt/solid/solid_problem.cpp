@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <petscsys.h>
 
+#include <array>
 #include <cmath>
 #include <memory>
 #include <vector>
@@ -47,16 +48,40 @@ contact::ContactParameters read_contact(const config::Section& root) {
   return parameters;
 }
 
+/// `impacts: {body: ball}`: the body whose impacts (find_impacts) a dynamic contact run
+/// reports; empty: none.
+std::string read_impact_body(const config::Section& root) {
+  if (!root.has("impacts")) return {};
+  const auto section = root.section("impacts", "impacts of a body against the others");
+  return section.require<std::string>(
+      "body", {"", "the body whose rebound angles and energy loss per impact are reported"});
+}
+
 class SolidProblem final : public run::Problem {
  public:
   SolidProblem(const config::Section& root, MPI_Comm comm)
       : contact_parameters_(read_contact(root)),
         hertz_(contact::HertzParameters::read(root)),
         patch_test_(contact::PatchTestParameters::read(root)),
+        impact_body_name_(read_impact_body(root)),
         solid_(root, comm) {
     if (contact_parameters_.enabled()) {
       contact_ = std::make_unique<contact::ContactHook>(contact_parameters_, solid_);
       solid_.set_hook(contact_.get());
+    }
+    if (parameters().time.contact_stabilized && !contact_)
+      log::warn(
+          "time.scheme contact_stabilized_newmark without a contact section: Newmark with a "
+          "lumped mass");
+    if (!impact_body_name_.empty()) {
+      const auto section = root.section("impacts", "impacts of a body against the others");
+      if (!parameters().time.dynamic || !contact_)
+        section.fail("body", "impacts are measured in dynamic runs with a contact section");
+      const auto& bodies = parameters().bodies;
+      for (std::size_t b = 0; b < bodies.size(); ++b)
+        if (bodies[b].name == impact_body_name_) impact_body_ = static_cast<int>(b);
+      if (impact_body_ < 0)
+        section.fail("body", fmt::format("no body named '{}' in `bodies`", impact_body_name_));
     }
   }
 
@@ -233,8 +258,32 @@ class SolidProblem final : public run::Problem {
       series.add("external_work", work);
       series.add("total_energy", total);
       series.add("newton_iterations", iterations);
+      const auto motions = solid_.body_motion();
+      for (const auto& motion : motions) {
+        for (int i = 0; i < dim(); ++i)
+          series.add(fmt::format("barycentre_{}_{}", kComponentNames[i], motion.name),
+                     motion.barycentre[i]);
+        for (int i = 0; i < dim(); ++i)
+          series.add(fmt::format("momentum_{}_{}", kComponentNames[i], motion.name),
+                     motion.momentum[i]);
+        if (dim() == 2)
+          series.add("angular_momentum_" + motion.name, motion.angular_momentum[2]);
+        else
+          for (int i = 0; i < 3; ++i)
+            series.add(fmt::format("angular_momentum_{}_{}", kComponentNames[i], motion.name),
+                       motion.angular_momentum[i]);
+      }
       if (contact_) contact_->add_series(output);
       series.end_row();
+      if (impact_body_ >= 0) {
+        const auto& motion = motions[static_cast<std::size_t>(impact_body_)];
+        std::array<double, 3> velocity{};
+        for (int i = 0; i < 3; ++i)
+          velocity[i] = motion.mass > 0 ? motion.momentum[i] / motion.mass : 0.0;
+        impact_velocity_.push_back(velocity);
+        impact_contact_.push_back(contact_->constraints().status().active > 0 ? 1 : 0);
+        impact_energy_.push_back(total);
+      }
     };
     int first_step = 1;
     if (restart_) {
@@ -258,6 +307,15 @@ class SolidProblem final : public run::Problem {
                         restart_->directory().string(), histories.size(), probe_history.size()));
       for (std::size_t k = 0; k < probe_history.size(); ++k)
         probe_history[k] = doubles(histories.at(k));
+      if (impact_body_ >= 0) {
+        const auto contact = doubles(state.at("impact_contact"));
+        const auto velocity = doubles(state.at("impact_velocity"));
+        impact_energy_ = doubles(state.at("impact_energy"));
+        for (std::size_t k = 0; k < contact.size(); ++k) {
+          impact_contact_.push_back(contact[k] != 0 ? 1 : 0);
+          impact_velocity_.push_back({velocity[3 * k], velocity[3 * k + 1], velocity[3 * k + 2]});
+        }
+      }
       log::info("continuing after step {} (t = {:g} s)", first_step - 1, times.back());
     } else {
       record(0, 0.0, 0);
@@ -275,6 +333,13 @@ class SolidProblem final : public run::Problem {
       state["times"] = io::Json::array_of(times);
       auto& histories = state["probe_history"] = io::Json::array();
       for (const auto& history : probe_history) histories.push_back(io::Json::array_of(history));
+      if (impact_body_ >= 0) {
+        std::vector<double> contact(impact_contact_.begin(), impact_contact_.end()), velocity;
+        for (const auto& v : impact_velocity_) velocity.insert(velocity.end(), v.begin(), v.end());
+        state["impact_contact"] = io::Json::array_of(contact);
+        state["impact_velocity"] = io::Json::array_of(velocity);
+        state["impact_energy"] = io::Json::array_of(impact_energy_);
+      }
       solid_.write_checkpoint(writer);
       writer.commit();
     };
@@ -324,15 +389,49 @@ class SolidProblem final : public run::Problem {
               initial_energy, drift);
     write_mesh_figures(benchmark);
     if (contact_) write_contact_figures(benchmark);
+    if (impact_body_ >= 0) write_impacts(benchmark, times);
     benchmark["time_step"] = time.step;
     auto& iterations = output.summary()["iterations"];
     iterations["newton"] = total_newton;
     iterations["linear"] = total_linear;
   }
 
+  /// The impacts of `impacts.body` (find_impacts) into the benchmark: per impact its times,
+  /// angles and energy loss, and the largest loss over the impacts.
+  void write_impacts(io::Json& benchmark, const std::vector<double>& times) const {
+    const auto impacts = find_impacts(times, impact_contact_, impact_velocity_, impact_energy_);
+    std::vector<double> incidence, rebound, loss, start;
+    double largest = 0;
+    for (const auto& impact : impacts) {
+      incidence.push_back(impact.incidence_angle);
+      rebound.push_back(impact.rebound_angle);
+      loss.push_back(impact.energy_loss);
+      start.push_back(impact.start_time);
+      largest = std::max(largest, impact.energy_loss);
+      log::info(
+          "impact of '{}' at t = {:g}..{:g} s: incidence {:.3f} deg, rebound {:.3f} deg, energy "
+          "{:.6e} -> {:.6e} (loss {:.3f} %)",
+          impact_body_name_, impact.start_time, impact.end_time, impact.incidence_angle,
+          impact.rebound_angle, impact.energy_before, impact.energy_after,
+          100 * impact.energy_loss);
+    }
+    benchmark["impacts"] = static_cast<std::int64_t>(impacts.size());
+    benchmark["impact_times"] = io::Json::array_of(start);
+    benchmark["incidence_angles"] = io::Json::array_of(incidence);
+    benchmark["rebound_angles"] = io::Json::array_of(rebound);
+    benchmark["energy_loss_per_impact"] = io::Json::array_of(loss);
+    benchmark["max_energy_loss_per_impact"] = largest;
+  }
+
   contact::ContactParameters contact_parameters_;
   contact::HertzParameters hertz_;
   contact::PatchTestParameters patch_test_;
+  std::string impact_body_name_;  ///< `impacts.body` ("" : none)
+  int impact_body_ = -1;          ///< its index in the bodies
+  // per recorded step: in contact, the body's barycentre velocity, the total energy
+  std::vector<char> impact_contact_;
+  std::vector<std::array<double, 3>> impact_velocity_;
+  std::vector<double> impact_energy_;
   SolidModel solid_;
   std::unique_ptr<contact::ContactHook> contact_;  ///< null without a `contact:` section
   const run::CheckpointReader* restart_ = nullptr;

@@ -3,6 +3,7 @@
 // summary of an oscillating signal.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -100,6 +101,34 @@ TEST(LastPeriod, TooShortOrFlatGivesNoPeriod) {
   EXPECT_EQ(last_period(t, flat).periods, 0);
   EXPECT_TRUE(std::isnan(last_period(t, flat).frequency));
   EXPECT_EQ(last_period(t, rising).periods, 0);
+}
+
+// A ball flying at 45° into a wall x = const and back out at 30°, then a second contact that
+// is still open at the end of the record (not an impact).
+TEST(FindImpacts, AnglesNormalAndEnergyLoss) {
+  const std::vector<double> t = {0, 1, 2, 3, 4, 5, 6, 7};
+  const std::vector<char> contact = {0, 0, 1, 1, 0, 0, 1, 1};
+  const double s = std::sqrt(3.0);
+  using V = std::array<double, 3>;
+  const std::vector<V> v = {{2, 2, 0},      {2, 2, 0},      {0.5, 2, 0}, {-1, 2, 0},
+                            {-2 / s, 2, 0}, {-2 / s, 2, 0}, {0, 0, 0},   {0, 0, 0}};
+  const std::vector<double> energy = {10, 10, 9.9, 9.8, 9.5, 9.5, 9.5, 9.5};
+  const auto impacts = find_impacts(t, contact, v, energy);
+  ASSERT_EQ(impacts.size(), 1u);
+  EXPECT_DOUBLE_EQ(impacts[0].start_time, 2.0);
+  EXPECT_DOUBLE_EQ(impacts[0].end_time, 4.0);
+  EXPECT_NEAR(impacts[0].incidence_angle, 45.0, 1e-12);
+  EXPECT_NEAR(impacts[0].rebound_angle, 30.0, 1e-12);  // tan 30° = (2/√3)/2
+  EXPECT_NEAR(impacts[0].energy_loss, 0.05, 1e-14);
+}
+
+TEST(FindImpacts, ContactFromTheStartOrWithoutChangeIsNoImpact) {
+  using V = std::array<double, 3>;
+  const std::vector<double> t = {0, 1, 2, 3, 4};
+  const std::vector<char> contact = {1, 0, 1, 0, 0};
+  const std::vector<V> v(5, V{1, 0, 0});
+  const std::vector<double> energy(5, 1.0);
+  EXPECT_TRUE(find_impacts(t, contact, v, energy).empty());
 }
 
 }  // namespace
