@@ -14,6 +14,8 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "coapt/core/config.hpp"
 #include "coapt/core/context.hpp"
@@ -129,7 +131,36 @@ TEST(CouplingConstraint, ForceOnSolidBalancesReactions) {
                 static_cast<int>(constraint.n_constrained()));
 }
 
+/// PETSc options for the lifetime of a test (cleared afterwards: every MPI test shares one
+/// process and one options database).
+class ScopedOptions {
+ public:
+  explicit ScopedOptions(std::vector<std::pair<std::string, std::string>> options)
+      : options_(std::move(options)) {
+    for (const auto& [name, value] : options_)
+      PetscOptionsSetValue(nullptr, name.c_str(), value.c_str());
+  }
+  ~ScopedOptions() {
+    for (const auto& option : options_) PetscOptionsClearValue(nullptr, option.first.c_str());
+  }
+  ScopedOptions(const ScopedOptions&) = delete;
+  ScopedOptions& operator=(const ScopedOptions&) = delete;
+
+ private:
+  std::vector<std::pair<std::string, std::string>> options_;
+};
+
 TEST(CouplingConstraint, RestoredStepRepeatsBitForBit) {
+  // A Krylov solver with a block-Jacobi preconditioner: its reductions run in a fixed order,
+  // so a repeated solve is bitwise the same. The default parallel direct solver (MUMPS) is not
+  // bitwise reproducible on more than one rank: its factorisation sums contributions in the
+  // order the messages arrive.
+  const ScopedOptions options({{"-fluid_ksp_type", "gmres"},
+                               {"-fluid_pc_type", "bjacobi"},
+                               {"-fluid_sub_pc_type", "lu"},
+                               {"-fluid_ksp_rtol", "1e-12"},
+                               {"-fluid_ksp_gmres_restart", "200"},
+                               {"-fluid_ksp_max_it", "2000"}});
   FluidModel fluid(read_case(), kWorld);
   const Mesh solid = solid_square();
   ImmersedConstraint constraint(fluid.mesh(), solid, {});

@@ -2,9 +2,14 @@
 #include "coapt/contact/solid_contact.hpp"
 
 #include <fmt/format.h>
+#include <petscsys.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
+#include <limits>
+#include <span>
 
 #include "coapt/core/error.hpp"
 #include "coapt/core/log.hpp"
@@ -100,6 +105,90 @@ HertzMeasurement measure_hertz(const ContactConstraints& constraints, bool spher
   return m;
 }
 
+ContactParameters read_solid_contact(const config::Section& root) {
+  auto parameters = ContactParameters::read(root);
+  if (parameters.enabled()) {
+    PetscBool ksp = PETSC_FALSE, pc = PETSC_FALSE, factor = PETSC_FALSE;
+    COAPT_PETSC_CHECK(PetscOptionsHasName(nullptr, "solid_", "-ksp_type", &ksp));
+    COAPT_PETSC_CHECK(PetscOptionsHasName(nullptr, "solid_", "-pc_type", &pc));
+    COAPT_PETSC_CHECK(
+        PetscOptionsHasName(nullptr, "solid_", "-pc_factor_mat_solver_type", &factor));
+    if (!ksp && !pc) {
+      COAPT_PETSC_CHECK(PetscOptionsSetValue(nullptr, "-solid_ksp_type", "preonly"));
+      COAPT_PETSC_CHECK(PetscOptionsSetValue(nullptr, "-solid_pc_type", "lu"));
+      if (!factor)
+        COAPT_PETSC_CHECK(
+            PetscOptionsSetValue(nullptr, "-solid_pc_factor_mat_solver_type", "mumps"));
+    }
+  }
+  return parameters;
+}
+
+namespace {
+
+using Point = std::array<double, 3>;
+
+Point point_of(std::span<const double> x, int dim, int node) {
+  Point p{};
+  for (int i = 0; i < dim; ++i) p[i] = x[static_cast<std::size_t>(node) * dim + i];
+  return p;
+}
+
+double dot(const Point& a, const Point& b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+Point minus(const Point& a, const Point& b) {
+  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+}
+
+/// Distance from p to the segment [a, b].
+double segment_distance(const Point& p, const Point& a, const Point& b) {
+  const Point ab = minus(b, a), ap = minus(p, a);
+  const double length2 = dot(ab, ab);
+  const double s = length2 > 0 ? std::clamp(dot(ap, ab) / length2, 0.0, 1.0) : 0.0;
+  const Point d{ap[0] - s * ab[0], ap[1] - s * ab[1], ap[2] - s * ab[2]};
+  return std::sqrt(dot(d, d));
+}
+
+/// Distance from p to the triangle (a, b, c): to its plane where p projects inside it, else
+/// to the nearest edge.
+double triangle_distance(const Point& p, const Point& a, const Point& b, const Point& c) {
+  const Point ab = minus(b, a), ac = minus(c, a), ap = minus(p, a);
+  const Point n{ab[1] * ac[2] - ab[2] * ac[1], ab[2] * ac[0] - ab[0] * ac[2],
+                ab[0] * ac[1] - ab[1] * ac[0]};
+  const double area2 = dot(n, n);
+  if (area2 > 0) {
+    // barycentric coordinates of the projection of p
+    const double d00 = dot(ab, ab), d01 = dot(ab, ac), d11 = dot(ac, ac);
+    const double d20 = dot(ap, ab), d21 = dot(ap, ac);
+    const double denominator = d00 * d11 - d01 * d01;
+    const double v = (d11 * d20 - d01 * d21) / denominator;
+    const double w = (d00 * d21 - d01 * d20) / denominator;
+    if (v >= 0 && w >= 0 && v + w <= 1) return std::abs(dot(ap, n)) / std::sqrt(area2);
+  }
+  return std::min(
+      {segment_distance(p, a, b), segment_distance(p, b, c), segment_distance(p, c, a)});
+}
+
+}  // namespace
+
+double surface_distance(const PairState& pair) {
+  const int dim = pair.slave.dim;
+  double distance = std::numeric_limits<double>::infinity();
+  for (int j = 0; j < pair.slave.n_nodes(); ++j) {
+    const Point p = point_of(pair.slave_x, dim, j);
+    for (int f = 0; f < pair.master.n_facets(); ++f) {
+      const auto nodes = pair.master.facet(f);
+      const Point a = point_of(pair.master_x, dim, nodes[0]);
+      const Point b = point_of(pair.master_x, dim, nodes[1]);
+      distance = std::min(
+          distance, dim == 2 ? segment_distance(p, a, b)
+                             : triangle_distance(p, a, b, point_of(pair.master_x, dim, nodes[2])));
+    }
+  }
+  return distance;
+}
+
 ContactHook::ContactHook(const ContactParameters& parameters, const solid::SolidModel& solid)
     : parameters_(parameters),
       constraints_(parameters, solid.mesh(), solid.dirichlet_dofs(), solid.displacement()) {}
@@ -147,13 +236,13 @@ std::vector<io::Field> ContactHook::fields() {
           {"contact_active", 1, io::Field::Location::vertex, active_}};
 }
 
-void ContactHook::add_series(run::RunOutput& output) const {
+void ContactHook::add_series(run::RunOutput& output, const std::string& suffix) const {
   const auto& s = constraints_.status();
   auto& series = output.series();
-  series.add("contact_active_nodes", s.active);
-  series.add("contact_max_pressure", s.max_pressure);
-  series.add("contact_total_force", s.total_force);
-  series.add("contact_max_penetration", s.max_penetration);
+  series.add("contact_active_nodes" + suffix, s.active);
+  series.add("contact_max_pressure" + suffix, s.max_pressure);
+  series.add("contact_total_force" + suffix, s.total_force);
+  series.add("contact_max_penetration" + suffix, s.max_penetration);
 }
 
 void ContactHook::write_nodes(const std::filesystem::path& file, MPI_Comm comm) const {

@@ -31,6 +31,17 @@
 
 namespace coapt::contact {
 
+/// Reads the `contact:` section of a solid's case section (ContactParameters::read); with
+/// contact, the solid's linear solver defaults to a direct one (MUMPS LU: the contact rows
+/// make the system non-symmetric with a coupling AMG does not expect) unless -solid_ksp_type
+/// or -solid_pc_type is given. Collective (PETSc options).
+ContactParameters read_solid_contact(const config::Section& root);
+
+/// The smallest distance between the slave and the master surface of a pair in its current
+/// configuration (PairState::slave_x, master_x): min over slave nodes of the distance to the
+/// master's facets (segments in 2D, triangles in 3D) [m]. +∞ for an empty surface. Serial.
+double surface_distance(const PairState& pair);
+
 /// The `hertz:` section (see the file comment); absent: `enabled` false.
 struct HertzParameters {
   bool enabled = false;
@@ -87,8 +98,9 @@ class ContactHook final : public solid::NewtonHook {
   const ContactConstraints& constraints() const { return constraints_; }
   /// The contact fields for SolidModel::write_vtk (pressure, gap, active set).
   std::vector<io::Field> fields();
-  /// Adds the contact columns of the current state to the series row being built.
-  void add_series(run::RunOutput& output) const;
+  /// Adds the contact columns of the current state to the series row being built, each name
+  /// followed by `suffix` (e.g. "_leaflets" when several solids have contact).
+  void add_series(run::RunOutput& output, const std::string& suffix = "") const;
   /// Writes every slave node of every pair as a CSV row (pair, reference coordinates,
   /// pressure [Pa], gap [m], active, constrained) to `file`, on rank 0 only. Collective.
   void write_nodes(const std::filesystem::path& file, MPI_Comm comm) const;

@@ -8,11 +8,13 @@
 #include <limits>
 #include <memory>
 
+#include "coapt/contact/solid_contact.hpp"
 #include "coapt/core/context.hpp"
 #include "coapt/core/error.hpp"
 #include "coapt/core/log.hpp"
 #include "coapt/core/progress.hpp"
 #include "coapt/coupling/immersed_constraint.hpp"
+#include "coapt/coupling/quasi_newton.hpp"
 #include "coapt/fem/assembly.hpp"
 #include "coapt/fluid/fluid_model.hpp"
 #include "coapt/mesh/mesh_input.hpp"
@@ -31,6 +33,8 @@ struct SolidEntry {
   mesh::MeshInput mesh;          ///< rigid: the mesh (deformable: solid::SolidModel reads it)
   std::vector<double> velocity;  ///< rigid: translation velocity [m/s]
   std::unique_ptr<config::Section> section;  ///< deformable: the entry, for solid::SolidModel
+  contact::ContactParameters contact;        ///< deformable: its `contact:` (between its bodies)
+  bool contact_stabilized = false;           ///< deformable, transient: the time scheme
 };
 
 /// The block Gauss–Seidel iteration of a step with deformable solids.
@@ -39,8 +43,13 @@ struct CouplingSettings {
   double relative_tolerance = 1e-6;  ///< on ‖f^l − f^(l−1)‖ / ‖f^1‖
   int max_iterations = 50;
   double relaxation = 0.5;  ///< ω of the first iteration (then Aitken's, if enabled)
-  bool aitken = true;
-  int retries = 2;  ///< stronger relaxation, then (transient) halved steps
+  enum class Method { constant, aitken, iqn_ils };
+  Method method = Method::aitken;
+  int reuse_steps = 8;   ///< iqn_ils: converged steps whose columns are reused
+  int max_columns = 60;  ///< iqn_ils: columns at most
+  double filter = 1e-8;  ///< iqn_ils: QR filter
+  int retries = 2;       ///< stronger relaxation, then (transient) halved steps
+  int freeze_after = 0;  ///< keep the constrained sets from this iteration of a step on (0: never)
 };
 
 /// `benchmark:` of an immersed body in a channel (the DFG cylinder).
@@ -54,6 +63,8 @@ struct Benchmark {
   double reference_displacement_x = 0, reference_displacement_y = 0;
   double mean_velocity = 1, diameter = 1;
   std::vector<double> pressure_points;  ///< x_A, y_A, x_B, y_B: Δp = p(A) − p(B)
+  // valve: the solid whose contact closes it and the boundary group whose flow is the leak
+  std::string valve_solid, flow_boundary;
   double reference_drag = 0, reference_lift = 0, reference_pressure_difference = 0;
 };
 
@@ -66,6 +77,7 @@ struct Parameters {
   fluid::TimeSettings time;
   Benchmark benchmark;
   bool write_vtk = true;
+  int vtk_interval = 0;  ///< transient: VTK every this many steps (0: the last step only)
 };
 
 Parameters read(const config::Section& root) {
@@ -73,8 +85,9 @@ Parameters read(const config::Section& root) {
   p.level = root.section("mesh", "refinement of every mesh of the case")
                 .get<int>("level", 0,
                           {"",
-                           "added to the refinement level of the fluid mesh and of every solid "
-                           "mesh (each level halves the element sizes)",
+                           "added to the refinement level of the fluid mesh and of every rigid "
+                           "solid's mesh (each level halves the element sizes); a deformable "
+                           "solid's mesh takes its own solids[].mesh.level",
                            Bounds::closed(0, 12)});
   const auto fluid = root.section(
       "fluid", "the fluid: mesh, boundary, outlets, pressure_reference and its material keys");
@@ -95,6 +108,14 @@ Parameters read(const config::Section& root) {
           "velocity", {}, {"m/s", "rigid: translation velocity of the body (empty: at rest)"});
     } else {
       solid.section = std::make_unique<config::Section>(entry);
+      solid.contact = contact::read_solid_contact(entry);
+      solid.contact_stabilized =
+          entry.choice("scheme", solid.contact.enabled() ? "contact_stabilized_newmark" : "newmark",
+                       {"newmark", "contact_stabilized_newmark"},
+                       {"",
+                        "transient coupling: the solid's time scheme (default: "
+                        "contact_stabilized_newmark with contact, else newmark)"}) ==
+          "contact_stabilized_newmark";
     }
     for (const auto& other : p.solids)
       if (other.name == solid.name)
@@ -132,7 +153,29 @@ Parameters read(const config::Section& root) {
   c.relaxation = iteration.get<double>(
       "relaxation", 0.5,
       {"", "relaxation factor of the force (first iteration)", Bounds{0, 1, true, false}});
-  c.aitken = iteration.get<bool>("aitken", true, {"", "Aitken's dynamic relaxation"});
+  const auto method = iteration.choice(
+      "method", "aitken", {"constant", "aitken", "iqn_ils"},
+      {"",
+       "force update: constant relaxation | aitken (dynamic relaxation) | iqn_ils (interface "
+       "quasi-Newton, least squares over this and past steps' iterates)"});
+  c.method = method == "constant" ? CouplingSettings::Method::constant
+             : method == "aitken" ? CouplingSettings::Method::aitken
+                                  : CouplingSettings::Method::iqn_ils;
+  c.reuse_steps = iteration.get<int>(
+      "reuse_steps", 8,
+      {"", "iqn_ils: converged steps whose iterates are reused", Bounds::closed(0, 100)});
+  c.max_columns = iteration.get<int>(
+      "max_columns", 60, {"", "iqn_ils: least-squares columns at most", Bounds::closed(1, 1000)});
+  c.filter = iteration.get<double>(
+      "filter", 1e-8,
+      {"", "iqn_ils: drop a column whose part orthogonal to the newer ones is below this fraction",
+       Bounds{0.0, 1.0, false, false}});
+  c.freeze_after = iteration.get<int>(
+      "freeze_constrained_after", 0,
+      {"",
+       "from this coupling iteration of a step on, keep each solid's set of constrained fluid "
+       "nodes (the covered-node rule makes the iteration map discontinuous; 0: never)",
+       Bounds::closed(0, 10000)});
   c.retries = iteration.get<int>(
       "retries", 2,
       {"", "failed step: retry with half the relaxation, then (transient) with half the step",
@@ -142,10 +185,23 @@ Parameters read(const config::Section& root) {
   auto benchmark = root.section("benchmark", "benchmark quantities written to summary.json");
   auto& b = p.benchmark;
   b.type = benchmark.choice(
-      "type", "none", {"none", "cylinder", "forces"},
+      "type", "none", {"none", "cylinder", "forces", "valve"},
       {"",
        "none | cylinder (force coefficients of an immersed body) | forces (drag, lift [N/m] "
-       "of boundary groups and solids, a probe's displacement)"});
+       "of boundary groups and solids, a probe's displacement) | valve (opening, penetration "
+       "and leak of a solid closing by contact)"});
+  if (b.type == "valve") {
+    b.valve_solid = benchmark.require<std::string>(
+        "solid", {"", "the deformable solid with contact whose closing is measured"});
+    b.flow_boundary = benchmark.require<std::string>(
+        "flow_boundary", {"", "fluid boundary group whose flow (out of the fluid) is the leak"});
+    const auto found = std::find_if(p.solids.begin(), p.solids.end(),
+                                    [&](const SolidEntry& s) { return s.name == b.valve_solid; });
+    if (found == p.solids.end() || !found->contact.enabled())
+      benchmark.fail("solid", fmt::format("no deformable solid '{}' with a contact section in "
+                                          "`solids`",
+                                          b.valve_solid));
+  }
   if (b.type == "forces") {
     b.boundaries = benchmark.get<std::vector<std::string>>(
         "boundaries", {}, {"", "fluid boundary groups whose force adds to drag and lift"});
@@ -185,16 +241,21 @@ Parameters read(const config::Section& root) {
                      [&](const SolidEntry& s) { return s.name == b.body; }))
       benchmark.fail("body", fmt::format("no solid named '{}' in `solids`", b.body));
   }
-  p.write_vtk = root.section("output", "what the run writes")
-                    .get<bool>("vtk", true, {"", "write the fluid and the solids as VTK"});
+  auto output = root.section("output", "what the run writes");
+  p.write_vtk = output.get<bool>("vtk", true, {"", "write the fluid and the solids as VTK"});
+  p.vtk_interval =
+      output.get<int>("vtk_interval", 0,
+                      {"", "transient: VTK every this many time steps (0: only at the end)",
+                       Bounds::closed(0, 1000000)});
   return p;
 }
 
 /// A solid in the coupling: its mesh and its constraint with the fluid.
 struct Solid {
   const SolidEntry* entry = nullptr;
-  mesh::QualityReport quality;               ///< rigid
-  std::unique_ptr<solid::SolidModel> model;  ///< deformable
+  mesh::QualityReport quality;                    ///< rigid
+  std::unique_ptr<solid::SolidModel> model;       ///< deformable
+  std::unique_ptr<contact::ContactHook> contact;  ///< deformable with `contact:`
   mesh::Mesh mesh;  ///< the current configuration (rigid: moved in place; deformable: X + u)
   std::unique_ptr<ImmersedConstraint> constraint;
   std::size_t first = 0;  ///< offset of its vertices in the fluid's constrained list
@@ -203,6 +264,7 @@ struct Solid {
   // deformable: the force the solid is loaded with (relaxed), its value at the step's start,
   // and the last residual f − f_applied (Aitken)
   OwnedVec applied, applied_start, residual, previous_residual;
+  OwnedVec applied_previous;  ///< iqn_ils: the applied force of the last iterate
 };
 
 /// What the coupling iterations of one step did.
@@ -230,6 +292,10 @@ class FsciProblem final : public run::Problem {
           throw InputError(fmt::format("{}: velocity: needs {} components", entry.where, dim));
       } else {
         solid->model = std::make_unique<solid::SolidModel>(*entry.section, comm);
+        if (entry.contact.enabled()) {
+          solid->contact = std::make_unique<contact::ContactHook>(entry.contact, *solid->model);
+          solid->model->set_hook(solid->contact.get());
+        }
         solid->mesh = solid->model->mesh();
         solid->quality = solid->model->quality();
         deformable_ = true;
@@ -239,11 +305,17 @@ class FsciProblem final : public run::Problem {
                                      entry.where, solid->mesh.dim, dim));
       solids_.push_back(std::move(solid));
     }
+    const auto& c = parameters_.coupling;
+    if (deformable_ && c.method == CouplingSettings::Method::iqn_ils)
+      quasi_newton_ =
+          std::make_unique<InterfaceQuasiNewton>(comm, c.reuse_steps, c.max_columns, c.filter);
     const auto& b = parameters_.benchmark;
     if (!b.pressure_points.empty() && dim != 2)
       throw InputError("benchmark.pressure_points: the pressure probes are a 2D quantity");
     for (const auto& group : b.boundaries)
       boundary_tags_.push_back(fluid_.boundary_tag(group, "benchmark.boundaries"));
+    if (b.type == "valve")
+      flow_tag_ = fluid_.boundary_tag(b.flow_boundary, "benchmark.flow_boundary");
     if (!b.probe.empty()) {
       const Solid* owner = find_solid(b.probe_solid);
       if (!owner || !owner->model)
@@ -264,8 +336,14 @@ class FsciProblem final : public run::Problem {
     for (const auto& solid : solids_) {
       const auto& entry = *solid->entry;
       if (solid->model) {
-        log::info("solid '{}' (deformable):", entry.name);
+        log::info("solid '{}' (deformable{}):", entry.name,
+                  parameters_.time.steady    ? ""
+                  : entry.contact_stabilized ? ", contact-stabilized Newmark"
+                                             : ", Newmark");
         solid->model->describe();
+        if (solid->contact)
+          log::info("solid '{}': contact (frictionless mortar, semi-smooth Newton): {}", entry.name,
+                    solid->contact->constraints().describe());
         continue;
       }
       log::info("solid '{}': {}, {} cells, {} vertices, shape quality in [{:.3f}, {:.3f}]; {}",
@@ -283,7 +361,10 @@ class FsciProblem final : public run::Problem {
           "coupling: block Gauss-Seidel, |df| < {:g} or |df|/|f^1| < {:g}, at most {} iterations, "
           "relaxation {:g}{}",
           c.absolute_tolerance, c.relative_tolerance, c.max_iterations, c.relaxation,
-          c.aitken ? " then Aitken" : "");
+          c.method == CouplingSettings::Method::aitken ? " then Aitken"
+          : c.method == CouplingSettings::Method::iqn_ils
+              ? fmt::format(" then IQN-ILS (reuse {} steps)", c.reuse_steps)
+              : std::string());
   }
 
   void run(run::RunOutput& output) override {
@@ -297,7 +378,7 @@ class FsciProblem final : public run::Problem {
         solid->force = solid->constraint->create_solid_vector();
         if (!solid->model) continue;
         for (auto* v : {&solid->applied, &solid->applied_start, &solid->residual,
-                        &solid->previous_residual}) {
+                        &solid->previous_residual, &solid->applied_previous}) {
           *v = solid->constraint->create_solid_vector();
           COAPT_PETSC_CHECK(VecSet(*v, 0.0));
         }
@@ -309,9 +390,11 @@ class FsciProblem final : public run::Problem {
       for (auto& solid : solids_)
         if (solid->model) {  // the fluid mesh carries ρ_f over the overlap
           solid->model->set_density_offset(p.fluid.fluid.density);
+          solid->model->set_contact_stabilized(solid->entry->contact_stabilized);
           solid->model->initialize_dynamics(output);
         }
     int newton_total = 0, linear_total = 0, coupling_total = 0;
+    int last_vtk_step = -1, n_steps_done = 0;  // transient VTK: the last step written
     if (p.time.steady) {
       const auto report = coupled_step(output, 0.0, 0.0, p.coupling.relaxation);
       if (!report.converged) {
@@ -334,12 +417,27 @@ class FsciProblem final : public run::Problem {
       int step = 0;
       while (fluid_.time() < p.time.end_time * (1 - 1e-12)) {
         const double dt = std::min(p.time.time_step, p.time.end_time - fluid_.time());
-        const auto report = step_with_retries(output, dt);
+        CouplingReport report;
+        try {
+          report = step_with_retries(output, dt);
+        } catch (const ConvergenceError&) {
+          // step_with_retries restored the last committed state: its figures and fields
+          // stay in the run folder next to the failure
+          benchmark(output);
+          if (p.write_vtk) write_vtk(output, fluid_.time());
+          throw;
+        }
         ++step;
+        n_steps_done = step;
         newton_total += report.fluid.iterations;
         linear_total += report.fluid.linear_iterations;
         coupling_total += report.iterations;
         record_step(output, fluid_.time(), report);
+        if (p.write_vtk && p.vtk_interval > 0 && step % p.vtk_interval == 0) {
+          ScopedTimer timer(output.timers(), "output");
+          write_vtk(output, fluid_.time());
+          last_vtk_step = step;
+        }
         progress.step(
             std::min(step, p.time.n_steps()), fluid_.time(),
             fmt::format("coupling {}, newton {}", report.iterations, report.fluid.iterations));
@@ -354,7 +452,7 @@ class FsciProblem final : public run::Problem {
       ScopedTimer timer(output.timers(), "benchmark");
       benchmark(output);
     }
-    if (p.write_vtk) {
+    if (p.write_vtk && (p.time.steady || last_vtk_step != n_steps_done)) {
       ScopedTimer timer(output.timers(), "output");
       write_vtk(output, p.time.steady ? 0.0 : p.time.end_time);
     }
@@ -396,8 +494,11 @@ class FsciProblem final : public run::Problem {
       } catch (const ConvergenceError& error) {
         result.converged = false;
         failures += fmt::format("\n  try {}: {}", attempt + 1, error.what());
+        log::warn("fsci: try {} of the step to t = {:g} s failed: {}", attempt + 1, fluid_.time(),
+                  error.what());
       }
       if (result.converged) {
+        if (quasi_newton_) quasi_newton_->end_step();
         fluid_.commit_step();
         for (auto& solid : solids_)
           if (solid->model) solid->model->commit();
@@ -409,6 +510,7 @@ class FsciProblem final : public run::Problem {
             fmt::format("\n  try {} (step {:g} s, relaxation {:g}): |df| {:.3e}", attempt + 1, step,
                         relaxation, fmt::join(result.coupling.history, ", "));
       fluid_.restore_step();
+      if (quasi_newton_) quasi_newton_->reset();
       for (auto& solid : solids_)
         if (solid->model) {
           solid->model->restore();
@@ -434,26 +536,54 @@ class FsciProblem final : public run::Problem {
     }
     for (auto& solid : solids_)
       if (solid->model) COAPT_PETSC_CHECK(VecCopy(solid->applied, solid->applied_start));
+    if (quasi_newton_) quasi_newton_->begin_step();
+    for (auto& solid : solids_) solid->constraint->set_frozen(false);
     double omega = relaxation, first_norm = 0;
+    bool fell_back = false;  // the last update was the relaxed fallback of a failed solid solve
     for (int iteration = 1; iteration <= (deformable_ ? c.max_iterations : 1); ++iteration) {
       report.iterations = iteration;
+      if (c.freeze_after > 0 && iteration == c.freeze_after)
+        for (auto& solid : solids_) solid->constraint->set_frozen(true);
+      bool solid_failed = false;
       for (auto& solid : solids_) {  // (1) and (2)
         if (!solid->model) continue;
         {
           ScopedTimer timer(output.timers(), "solid");
-          if (steady)
-            solid->model->solve_static(
-                1.0, output,
-                fmt::format("solid '{}', coupling iteration {}", solid->entry->name, iteration),
-                false);
-          else
-            solid->model->step(time, dt, output);
+          try {
+            if (steady)
+              solid->model->solve_static(
+                  1.0, output,
+                  fmt::format("solid '{}', coupling iteration {}", solid->entry->name, iteration),
+                  false);
+            else
+              solid->model->step(time, dt, output);
+          } catch (const ConvergenceError& error) {
+            // A quasi-Newton force can overshoot where the map is not smooth (the set of
+            // constrained fluid nodes changes as the solid moves): fall back once to the
+            // relaxed update of the last iterate, x + ω r, without the columns.
+            if (!quasi_newton_ || steady || iteration == 1 || fell_back) throw;
+            log::warn("fsci: coupling iteration {}: {}; back to the relaxed update", iteration,
+                      error.what());
+            solid_failed = true;
+            break;
+          }
         }
         ScopedTimer timer(output.timers(), "transfer");
         const auto coordinates = solid->model->current_coordinates();
         std::copy(coordinates.begin(), coordinates.end(), solid->mesh.coordinates.begin());
         solid->constraint->update_solid(solid->mesh);
       }
+      if (solid_failed) {
+        quasi_newton_->reset();
+        for (auto& s : solids_)
+          if (s->model)
+            COAPT_PETSC_CHECK(VecWAXPY(s->applied, omega, s->residual, s->applied_previous));
+        report.history.push_back(std::numeric_limits<double>::quiet_NaN());
+        report.relaxation.push_back(omega);
+        fell_back = true;
+        continue;
+      }
+      fell_back = false;
       apply_constraint(steady);  // (3)
       {
         ScopedTimer timer(output.timers(), "fluid");
@@ -495,21 +625,61 @@ class FsciProblem final : public run::Problem {
       const double norm = std::sqrt(norm2);
       if (iteration == 1) first_norm = std::sqrt(force2);
       report.history.push_back(norm);
-      if (iteration > 1 && c.aitken && difference2 > 0)
+      if (iteration > 1 && c.method == CouplingSettings::Method::aitken && difference2 > 0)
         omega = std::clamp(-omega * dot / difference2, 0.01, 1.0);
-      report.relaxation.push_back(omega);
+      report.relaxation.push_back(quasi_newton_ ? std::numeric_limits<double>::quiet_NaN() : omega);
       if (norm <= c.absolute_tolerance || norm <= c.relative_tolerance * first_norm) {
         result.converged = true;
         break;
       }
+      if (quasi_newton_) {
+        for (auto& solid : solids_)
+          if (solid->model) COAPT_PETSC_CHECK(VecCopy(solid->applied, solid->applied_previous));
+        quasi_newton_update(omega);
+        continue;
+      }
       for (auto& solid : solids_)
         if (solid->model) COAPT_PETSC_CHECK(VecAXPY(solid->applied, omega, solid->residual));
     }
-    log::info("{}: {} coupling iteration(s){}, |f - f_applied| {:.3e}; omega {:.3f}",
+    log::info("{}: {} coupling iteration(s){}, |f - f_applied| {:.3e}; {}",
               steady ? std::string("steady") : fmt::format("t = {:g} s", time), report.iterations,
               result.converged ? "" : " (not converged)", fmt::join(report.history, ", "),
-              fmt::join(report.relaxation, ", "));
+              quasi_newton_ ? fmt::format("IQN-ILS, {} column(s) in the last update", last_columns_)
+                            : fmt::format("omega {:.3f}", fmt::join(report.relaxation, ", ")));
     return result;
+  }
+
+  /// The IQN-ILS update of the applied forces: x = the applied forces, x̃ = the forces of the
+  /// last fluid solve, over the owned entries of every deformable solid (quasi_newton.hpp).
+  void quasi_newton_update(double omega) {
+    std::vector<double> x, x_tilde;
+    const auto append = [](Vec vector, std::vector<double>& values) {
+      PetscInt n = 0;
+      const PetscScalar* data = nullptr;
+      COAPT_PETSC_CHECK(VecGetLocalSize(vector, &n));
+      COAPT_PETSC_CHECK(VecGetArrayRead(vector, &data));
+      values.insert(values.end(), data, data + n);
+      COAPT_PETSC_CHECK(VecRestoreArrayRead(vector, &data));
+    };
+    for (auto& solid : solids_)
+      if (solid->model) {
+        append(solid->applied, x);
+        append(solid->force, x_tilde);
+      }
+    std::vector<double> next(x.size());
+    last_columns_ = quasi_newton_->next(x, x_tilde, omega, next);
+    std::size_t offset = 0;
+    for (auto& solid : solids_) {
+      if (!solid->model) continue;
+      PetscInt n = 0;
+      PetscScalar* data = nullptr;
+      COAPT_PETSC_CHECK(VecGetLocalSize(solid->applied, &n));
+      COAPT_PETSC_CHECK(VecGetArray(solid->applied, &data));
+      std::copy(next.begin() + static_cast<std::ptrdiff_t>(offset),
+                next.begin() + static_cast<std::ptrdiff_t>(offset) + n, data);
+      COAPT_PETSC_CHECK(VecRestoreArray(solid->applied, &data));
+      offset += static_cast<std::size_t>(n);
+    }
   }
 
   /// Rigid solids with a velocity translate by dt·velocity; their operators are re-assembled.
@@ -584,6 +754,52 @@ class FsciProblem final : public run::Problem {
     }
   }
 
+  /// The valve benchmark's history: per recorded step the opening (the distance between the
+  /// surfaces of the solid's first contact pair), whether it is closed (active contact nodes),
+  /// the flow out through benchmark.flow_boundary and the largest penetration.
+  void record_valve(double time, double opening, const Solid& solid) {
+    const auto& status = solid.contact->constraints().status();
+    valve_.times.push_back(time);
+    valve_.opening.push_back(opening);
+    valve_.closed.push_back(status.active > 0 ? 1 : 0);
+    valve_.flow.push_back(fluid_.navier_stokes().boundary_flow(flow_tag_));
+    valve_.max_penetration = std::max(valve_.max_penetration, status.max_penetration);
+  }
+
+  /// Closed phases (runs of steps with contact), the volume through flow_boundary in each
+  /// (Σ Q Δt over its steps), the extremes of the opening and the largest penetration.
+  void valve_benchmark(io::Json& json) const {
+    std::vector<double> leak, phase_start, phase_end;
+    double largest = 0, smallest = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < valve_.times.size(); ++k) {
+      if (std::isfinite(valve_.opening[k])) {
+        largest = std::max(largest, valve_.opening[k]);
+        smallest = std::min(smallest, valve_.opening[k]);
+      }
+      if (!valve_.closed[k]) continue;
+      const double dt = k > 0 ? valve_.times[k] - valve_.times[k - 1] : 0.0;
+      if (k == 0 || !valve_.closed[k - 1]) {
+        leak.push_back(0.0);
+        phase_start.push_back(valve_.times[k]);
+        phase_end.push_back(valve_.times[k]);
+      }
+      leak.back() += valve_.flow[k] * dt;
+      phase_end.back() = valve_.times[k];
+    }
+    json["closed_phases"] = static_cast<std::int64_t>(leak.size());
+    json["closed_phase_start"] = io::Json::array_of(phase_start);
+    json["closed_phase_end"] = io::Json::array_of(phase_end);
+    json["leak_volume"] = io::Json::array_of(leak);
+    json["max_penetration"] = valve_.max_penetration;
+    json["max_opening"] = largest;
+    json["min_opening"] = std::isfinite(smallest) ? smallest : 0.0;
+    log::info(
+        "valve: {} closed phase(s), leak volume {} m^2 (2D) / m^3, opening in [{:.4e}, "
+        "{:.4e}] m, max penetration {:.3e} m",
+        leak.size(), fmt::join(leak, ", "), json["min_opening"].as_double(), largest,
+        valve_.max_penetration);
+  }
+
   /// c = 2F/(ρŪ²D) of the benchmark body.
   double coefficient_scale() const {
     const auto& b = parameters_.benchmark;
@@ -636,6 +852,14 @@ class FsciProblem final : public run::Problem {
           series.add(fmt::format("{}_{}_u{}", name, names[k].name, axes[i]), probes[k][i]);
       series.add("kinetic_energy_" + name, solid->model->kinetic_energy());
       series.add("volume_" + name, solid->model->volume());
+      if (!solid->contact) continue;
+      solid->contact->add_series(output, "_" + name);
+      const auto& pairs = solid->contact->constraints().pairs();
+      const double opening = pairs.empty() || pairs[0].slave_x.empty()
+                                 ? std::numeric_limits<double>::quiet_NaN()
+                                 : contact::surface_distance(pairs[0]);
+      series.add("opening_" + name, opening);
+      if (name == parameters_.benchmark.valve_solid) record_valve(time, opening, *solid);
     }
     if (parameters_.benchmark.type == "forces") {
       const auto force = benchmark_force();
@@ -670,6 +894,7 @@ class FsciProblem final : public run::Problem {
     }
     log::info("force balance: max |sum B^T lambda - sum reactions| / |sum reactions| = {:.3e}",
               force_balance_);
+    if (b.type == "valve") valve_benchmark(json);
     if (b.type == "forces") {
       const auto force = benchmark_force();
       json["drag"] = force[0];
@@ -743,8 +968,13 @@ class FsciProblem final : public run::Problem {
         for (std::size_t k = 0; k < force.size(); ++k) force[k] = local[k];
       }
       if (solid->model) {  // the solid's own series "solid", with the coupling force
-        solid->model->write_vtk(output, time,
-                                {{"coupling_force", dim, io::Field::Location::vertex, force}});
+        std::vector<io::Field> fields = {
+            {"coupling_force", dim, io::Field::Location::vertex, force}};
+        if (solid->contact) {
+          const auto contact_fields = solid->contact->fields();
+          fields.insert(fields.end(), contact_fields.begin(), contact_fields.end());
+        }
+        solid->model->write_vtk(output, time, fields);
         continue;
       }
       const std::vector<io::Field> fields = {{"force", dim, io::Field::Location::vertex, force}};
@@ -756,10 +986,18 @@ class FsciProblem final : public run::Problem {
   MPI_Comm comm_;
   fluid::FluidModel fluid_;
   std::vector<std::unique_ptr<Solid>> solids_;
-  double force_balance_ = 0;        ///< max over solids of the relative force balance error
-  bool deformable_ = false;         ///< some solid is deformable: coupling iterations
-  std::vector<int> boundary_tags_;  ///< benchmark.boundaries
-  int probe_index_ = -1;            ///< benchmark.probe in its solid's probes
+  double force_balance_ = 0;  ///< max over solids of the relative force balance error
+  bool deformable_ = false;   ///< some solid is deformable: coupling iterations
+  std::unique_ptr<InterfaceQuasiNewton> quasi_newton_;  ///< coupling.iteration.method iqn_ils
+  int last_columns_ = 0;                                ///< columns of the last IQN-ILS update
+  std::vector<int> boundary_tags_;                      ///< benchmark.boundaries
+  int flow_tag_ = -1;                                   ///< benchmark.flow_boundary (valve)
+  struct ValveHistory {
+    std::vector<double> times, opening, flow;
+    std::vector<char> closed;
+    double max_penetration = 0;
+  } valve_;
+  int probe_index_ = -1;  ///< benchmark.probe in its solid's probes
 };
 
 }  // namespace

@@ -32,18 +32,30 @@ void ImmersedConstraint::collect() {
   // B ⊗ I_dim acts on interleaved vertex vectors; re-created because update_master may have
   // re-created B.
   COAPT_PETSC_CHECK(MatCreateMAIJ(transfer_->coupling(), fluid_.dim, coupling_.out()));
+  std::vector<int> vertices;
+  if (frozen_) {
+    vertices = constrained_;
+  } else {
+    for (const PetscInt row : transfer_->constrained_rows()) {
+      const auto v = static_cast<int>(row - fluid_.vertex_offset);
+      if (v < 0 || v >= fluid_.n_owned_vertices || fluid_.global_vertex[v] != row)
+        throw InternalError("immersed constraint: a constrained row is not an owned fluid vertex");
+      vertices.push_back(v);
+    }
+  }
   constrained_.clear();
   dual_.clear();
   const PetscScalar* dual = nullptr;
   COAPT_PETSC_CHECK(VecGetArrayRead(transfer_->dual_mass(), &dual));
-  for (const PetscInt row : transfer_->constrained_rows()) {
-    const auto v = static_cast<int>(row - fluid_.vertex_offset);
-    if (v < 0 || v >= fluid_.n_owned_vertices || fluid_.global_vertex[v] != row)
-      throw InternalError("immersed constraint: a constrained row is not an owned fluid vertex");
+  for (const int v : vertices) {
+    if (frozen_ && !(dual[v] > 0.0)) continue;  // no longer covered: T is not defined there
     constrained_.push_back(v);
     dual_.push_back(dual[v]);
   }
   COAPT_PETSC_CHECK(VecRestoreArrayRead(transfer_->dual_mass(), &dual));
+  long long count = static_cast<long long>(constrained_.size());
+  MPI_Allreduce(MPI_IN_PLACE, &count, 1, MPI_LONG_LONG, MPI_SUM, fluid_.comm);
+  n_constrained_ = static_cast<PetscInt>(count);
 }
 
 std::vector<double> ImmersedConstraint::transfer_velocity(Vec solid_velocity) const {

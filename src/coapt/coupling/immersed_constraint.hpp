@@ -41,13 +41,21 @@ class ImmersedConstraint {
   ImmersedConstraint(const mesh::Mesh& fluid, const mesh::Mesh& solid,
                      const transfer::TransferOptions& options);
 
-  /// The solid moved (same mesh, new coordinates): re-assembles B, D and the constrained set.
+  /// The solid moved (same mesh, new coordinates): re-assembles B, D and the constrained set
+  /// (while frozen: B and D only).
   void update_solid(const mesh::Mesh& moved);
+  /// Frozen: update_solid() keeps the constrained set it has (less the nodes whose D_i is no
+  /// longer positive) instead of applying the covered-node rule again. The coupling freezes
+  /// it after some iterations of a step: the rule makes the fixed-point map discontinuous
+  /// (a node enters or leaves the set as the solid moves by round-off), which can trap the
+  /// iteration in a limit cycle.
+  void set_frozen(bool frozen) { frozen_ = frozen; }
+  bool frozen() const { return frozen_; }
 
   /// Owned local fluid vertices of the constrained set, ascending.
   const std::vector<int>& constrained_vertices() const { return constrained_; }
   /// Number of constrained fluid vertices over all ranks.
-  PetscInt n_constrained() const { return transfer_->n_constrained(); }
+  PetscInt n_constrained() const { return n_constrained_; }
 
   /// T v_s at the constrained vertices (constrained_vertices().size() × dim, row-major) from a
   /// solid vertex vector with dim components [m/s].
@@ -81,6 +89,8 @@ class ImmersedConstraint {
   OwnedVec fluid_work_;           ///< fluid layout, dim components
   std::vector<int> constrained_;  ///< owned local fluid vertices
   std::vector<double> dual_;      ///< D_i at constrained_
+  PetscInt n_constrained_ = 0;    ///< constrained_ summed over the ranks
+  bool frozen_ = false;
 };
 
 }  // namespace coapt::coupling

@@ -19,22 +19,45 @@ namespace {
 
 using config::Bounds;
 
-/// The waveform's factor at time t (1 when steady, t = ∞).
-double waveform_factor(const BoundaryCondition& bc, double time) {
-  if (!std::isfinite(time) || bc.waveform == BoundaryCondition::Waveform::none) return 1.0;
-  if (bc.waveform == BoundaryCondition::Waveform::sinusoid)
-    return 1 + bc.amplitude * std::sin(2 * std::numbers::pi * time / bc.period);
+}  // namespace
+
+double TimeWaveform::factor(double time) const {
+  if (!std::isfinite(time) || kind == Kind::none) return 1.0;
+  if (kind == Kind::sinusoid) return 1 + amplitude * std::sin(2 * std::numbers::pi * time / period);
   double t = time;
-  if (bc.period > 0) t = bc.times.front() + std::fmod(time - bc.times.front(), bc.period);
-  if (t <= bc.times.front()) return bc.factors.front();
-  if (t >= bc.times.back()) return bc.factors.back();
-  const auto k = static_cast<std::size_t>(std::upper_bound(bc.times.begin(), bc.times.end(), t) -
-                                          bc.times.begin());
-  const double s = (t - bc.times[k - 1]) / (bc.times[k] - bc.times[k - 1]);
-  return (1 - s) * bc.factors[k - 1] + s * bc.factors[k];
+  if (period > 0) t = times.front() + std::fmod(time - times.front(), period);
+  if (t <= times.front()) return factors.front();
+  if (t >= times.back()) return factors.back();
+  const auto k =
+      static_cast<std::size_t>(std::upper_bound(times.begin(), times.end(), t) - times.begin());
+  const double s = (t - times[k - 1]) / (times[k] - times[k - 1]);
+  return (1 - s) * factors[k - 1] + s * factors[k];
 }
 
-}  // namespace
+TimeWaveform TimeWaveform::read(const config::Section& waveform) {
+  TimeWaveform w;
+  const auto kind = waveform.choice(
+      "type", "none", {"none", "sinusoid", "table"},
+      {"", "none | sinusoid (1 + a sin(2πt/T)) | table (linear in time; steady runs: none)"});
+  if (kind == "sinusoid") {
+    w.kind = Kind::sinusoid;
+    w.amplitude = waveform.require<double>("amplitude", {"", "a of 1 + a sin(2πt/T)"});
+    w.period = waveform.require<double>("period", {"s", "period T", Bounds::positive()});
+  } else if (kind == "table") {
+    w.kind = Kind::table;
+    w.times = waveform.require<std::vector<double>>("times", {"s", "table times, increasing"});
+    w.factors = waveform.require<std::vector<double>>("values", {"", "factor at each time"});
+    w.period =
+        waveform.get<double>("period", 0.0,
+                             {"s", "repeat the table with this period (0: hold the last value)",
+                              Bounds::non_negative()});
+    if (w.times.size() < 2 || w.times.size() != w.factors.size())
+      waveform.fail("values", "needs at least 2 entries, as many as times");
+    for (std::size_t k = 1; k < w.times.size(); ++k)
+      if (!(w.times[k] > w.times[k - 1])) waveform.fail("times", "must increase");
+  }
+  return w;
+}
 
 FluidCase FluidCase::read(const config::Section& section, const config::Section& properties) {
   FluidCase p;
@@ -88,27 +111,8 @@ FluidCase FluidCase::read(const config::Section& section, const config::Section&
         bc.radius = entry.require<double>("radius",
                                           {"m", "radial: radius of the inlet", Bounds::positive()});
       }
-      auto waveform = entry.section("waveform", "periodic factor on the value in time");
-      const auto kind = waveform.choice(
-          "type", "none", {"none", "sinusoid", "table"},
-          {"", "none | sinusoid (1 + a sin(2πt/T)) | table (linear in time; steady runs: none)"});
-      if (kind == "sinusoid") {
-        bc.waveform = BoundaryCondition::Waveform::sinusoid;
-        bc.amplitude = waveform.require<double>("amplitude", {"", "a of 1 + a sin(2πt/T)"});
-        bc.period = waveform.require<double>("period", {"s", "period T", Bounds::positive()});
-      } else if (kind == "table") {
-        bc.waveform = BoundaryCondition::Waveform::table;
-        bc.times = waveform.require<std::vector<double>>("times", {"s", "table times, increasing"});
-        bc.factors = waveform.require<std::vector<double>>("values", {"", "factor at each time"});
-        bc.period =
-            waveform.get<double>("period", 0.0,
-                                 {"s", "repeat the table with this period (0: hold the last value)",
-                                  Bounds::non_negative()});
-        if (bc.times.size() < 2 || bc.times.size() != bc.factors.size())
-          waveform.fail("values", "needs at least 2 entries, as many as times");
-        for (std::size_t k = 1; k < bc.times.size(); ++k)
-          if (!(bc.times[k] > bc.times[k - 1])) waveform.fail("times", "must increase");
-      }
+      bc.waveform =
+          TimeWaveform::read(entry.section("waveform", "periodic factor on the value in time"));
       bc.ramp_time = entry.get<double>(
           "ramp_time", 0.0,
           {"s", "smooth ramp (1 − cos(πt/T))/2 up to this time (0: none)", Bounds::non_negative()});
@@ -126,8 +130,12 @@ FluidCase FluidCase::read(const config::Section& section, const config::Section&
     outlet.type = type == "do_nothing" ? OutletCondition::Type::do_nothing
                   : type == "traction" ? OutletCondition::Type::traction
                                        : OutletCondition::Type::windkessel;
-    if (outlet.type == OutletCondition::Type::traction)
-      outlet.pressure = entry.require<double>("pressure", {"Pa", "traction: outlet pressure P"});
+    if (outlet.type == OutletCondition::Type::traction) {
+      outlet.pressure = entry.require<double>(
+          "pressure", {"Pa", "traction: outlet pressure P (times the waveform's factor)"});
+      outlet.waveform = TimeWaveform::read(entry.section(
+          "waveform", "traction: factor on the pressure in time (a pressure-driven inlet)"));
+    }
     if (outlet.type == OutletCondition::Type::windkessel) {
       auto w = entry.section("windkessel",
                              "RCR parameters: P = R_p Q + P_c, C dP_c/dt = Q − (P_c − P_d)/R_d");
@@ -490,8 +498,9 @@ void FluidModel::set_outlet_pressures(double dt) {
         fluid_->set_outlet_pressure(k, wk.proximal_resistance + wk.distal_resistance,
                                     wk.distal_pressure);
       }
-    } else {
-      fluid_->set_outlet_pressure(k, 0.0, outlet.pressure);
+    } else {  // steady solves (dt = 0) take the waveform's factor 1
+      const double time = dt > 0 ? time_ : std::numeric_limits<double>::infinity();
+      fluid_->set_outlet_pressure(k, 0.0, outlet.pressure * outlet.waveform.factor(time));
     }
   }
 }
@@ -522,7 +531,7 @@ void FluidModel::write_boundary_values(double time) {
         for (int i = 0; i < dim; ++i) r2 += std::pow(mesh_.point(v)[i] - bc.centre[i], 2);
         factor *= std::max(0.0, 1 - r2 / (bc.radius * bc.radius));
       }
-      factor *= waveform_factor(bc, time);
+      factor *= bc.waveform.factor(time);
     }
     for (int i = 0; i < dim; ++i) {
       const double value = bc.type == BoundaryCondition::Type::velocity ? factor * bc.value[i] : 0;

@@ -40,11 +40,25 @@
 
 namespace coapt::fluid {
 
+/// A periodic or tabulated factor in time: none (1), sinusoid 1 + a sin(2πt/T), or a table
+/// linear between its points (repeated with `period` when > 0, else holding its ends). Steady
+/// solves (t = ∞) take 1.
+struct TimeWaveform {
+  enum class Kind { none, sinusoid, table };
+  Kind kind = Kind::none;
+  double amplitude = 0;                ///< sinusoid: a
+  double period = 0;                   ///< sinusoid, table: T [s] (table: 0 = not periodic)
+  std::vector<double> times, factors;  ///< table: factor(t), linear in between
+  /// The factor at time t [s]; 1 when t is not finite (steady).
+  double factor(double time) const;
+  /// Reads a `waveform:` section (`type`, `amplitude`, `period`, `times`, `values`).
+  static TimeWaveform read(const config::Section& section);
+};
+
 /// One entry of `boundary:`; later entries override earlier ones at shared vertices.
 struct BoundaryCondition {
   enum class Type { velocity, no_slip, outflow };
   enum class Profile { constant, parabolic, radial };
-  enum class Waveform { none, sinusoid, table };
   std::string group;
   std::string where;  ///< file:line of the entry
   Type type = Type::no_slip;
@@ -54,10 +68,7 @@ struct BoundaryCondition {
   double ramp_time = 0;          ///< > 0: value × (1 − cos(π min(t/T, 1)))/2 [s]
   std::vector<double> centre;    ///< radial: the axis point of the inlet plane [m]
   double radius = 0;             ///< radial: value × (1 − r²/radius²) [m]
-  Waveform waveform = Waveform::none;
-  double amplitude = 0;                ///< sinusoid: value × (1 + a sin(2πt/T))
-  double period = 0;                   ///< sinusoid, table: T [s] (table: 0 = not periodic)
-  std::vector<double> times, factors;  ///< table: value × factor(t), linear in between
+  TimeWaveform waveform;         ///< value × waveform.factor(t)
 };
 
 /// An entry of `outlets:`: the pressure on a facet group, fixed or from a Windkessel.
@@ -66,7 +77,8 @@ struct OutletCondition {
   std::string group;
   std::string where;
   Type type = Type::do_nothing;
-  double pressure = 0;  ///< traction: P [Pa]
+  double pressure = 0;    ///< traction: P [Pa], times waveform.factor(t)
+  TimeWaveform waveform;  ///< traction: P(t) = pressure × factor(t) (e.g. a pressure-driven inlet)
   lumped::WindkesselParameters windkessel;
   double backflow = 0;  ///< β
 };

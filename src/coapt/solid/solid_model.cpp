@@ -202,6 +202,11 @@ class SolidModelImpl {
     hook_ = hook;
   }
 
+  void set_contact_stabilized(bool contact_stabilized) {
+    if (mass_) throw InternalError("solid: set_contact_stabilized() after initialize_dynamics()");
+    parameters_.time.contact_stabilized = contact_stabilized;
+  }
+
   void set_density_offset(double offset) {
     for (const auto& body : parameters_.bodies)
       if (body.density - offset < 0)
@@ -1508,6 +1513,9 @@ void SolidModel::read_checkpoint(const run::CheckpointReader& reader, const std:
 }
 std::vector<std::vector<double>> SolidModel::probe_values() const {
   return impl_->probe_values();
+}
+void SolidModel::set_contact_stabilized(bool contact_stabilized) {
+  impl_->set_contact_stabilized(contact_stabilized);
 }
 std::vector<BodyMotion> SolidModel::body_motion() const {
   return impl_->body_motion();

@@ -141,6 +141,10 @@ class SolidModel {
   /// Inertia uses the density ρ_body − offset [kg/m³] (≥ 0 for every body, else InputError).
   /// Call before initialize_dynamics().
   void set_density_offset(double offset);
+  /// The time scheme of step(): plain Newmark (false) or contact-stabilized Newmark (true),
+  /// for drivers that choose it themselves (the immersed coupling). Call before
+  /// initialize_dynamics().
+  void set_contact_stabilized(bool contact_stabilized);
 
   /// One quasi-static load step at load factor s (0 < s ≤ 1). Throws ConvergenceError with
   /// the residual history when Newton fails. `verbose` logs every Newton iteration.

@@ -26,28 +26,6 @@ namespace {
 
 constexpr const char* kComponentNames[3] = {"x", "y", "z"};
 
-/// Reads the `contact:` section; with contact, the solid's linear solver defaults to a direct
-/// one (MUMPS LU: the contact rows make the system non-symmetric with coupling that AMG does
-/// not expect) unless -solid_ksp_type or -solid_pc_type is given.
-contact::ContactParameters read_contact(const config::Section& root) {
-  auto parameters = contact::ContactParameters::read(root);
-  if (parameters.enabled()) {
-    PetscBool ksp = PETSC_FALSE, pc = PETSC_FALSE, factor = PETSC_FALSE;
-    COAPT_PETSC_CHECK(PetscOptionsHasName(nullptr, "solid_", "-ksp_type", &ksp));
-    COAPT_PETSC_CHECK(PetscOptionsHasName(nullptr, "solid_", "-pc_type", &pc));
-    COAPT_PETSC_CHECK(
-        PetscOptionsHasName(nullptr, "solid_", "-pc_factor_mat_solver_type", &factor));
-    if (!ksp && !pc) {
-      COAPT_PETSC_CHECK(PetscOptionsSetValue(nullptr, "-solid_ksp_type", "preonly"));
-      COAPT_PETSC_CHECK(PetscOptionsSetValue(nullptr, "-solid_pc_type", "lu"));
-      if (!factor)
-        COAPT_PETSC_CHECK(
-            PetscOptionsSetValue(nullptr, "-solid_pc_factor_mat_solver_type", "mumps"));
-    }
-  }
-  return parameters;
-}
-
 /// `impacts: {body: ball}`: the body whose impacts (find_impacts) a dynamic contact run
 /// reports; empty: none.
 std::string read_impact_body(const config::Section& root) {
@@ -60,7 +38,7 @@ std::string read_impact_body(const config::Section& root) {
 class SolidProblem final : public run::Problem {
  public:
   SolidProblem(const config::Section& root, MPI_Comm comm)
-      : contact_parameters_(read_contact(root)),
+      : contact_parameters_(contact::read_solid_contact(root)),
         hertz_(contact::HertzParameters::read(root)),
         patch_test_(contact::PatchTestParameters::read(root)),
         impact_body_name_(read_impact_body(root)),
