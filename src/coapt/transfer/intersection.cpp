@@ -60,6 +60,7 @@ template <int dim>
 struct Overlap {
   enum class Kind { empty, small_inside, large_inside, clipped };
   Kind kind = Kind::empty;
+  bool separated = true;  ///< empty by the rejection tests (false: passed them)
   bool a_is_small = true;
   const Simplex<dim>* small = nullptr;  ///< S (A until the pair is classified)
   const Simplex<dim>* large = nullptr;  ///< L
@@ -98,6 +99,7 @@ Overlap<dim> find_overlap(const Simplex<dim>& a, const Simplex<dim>& b, Polytope
     if (lowest < -tol) cutting |= 1u << j;
   }
   if (cutting == 0) {
+    overlap.separated = false;
     overlap.kind = Kind::small_inside;
     return overlap;
   }
@@ -115,6 +117,7 @@ Overlap<dim> find_overlap(const Simplex<dim>& a, const Simplex<dim>& b, Polytope
     if (!(highest > tol)) return overlap;
     if (lowest < -tol) large_inside = false;
   }
+  overlap.separated = false;
   if (large_inside) {
     overlap.kind = Kind::large_inside;
     return overlap;
@@ -210,8 +213,8 @@ bool moments_of_intersection(const Simplex<dim>& a, const Simplex<dim>& b,
 }
 
 template <int dim>
-bool integrals_of_intersection(const Simplex<dim>& a, const Simplex<dim>& b,
-                               IntersectionWorkspace<dim>& workspace, LocalIntegrals<dim>& out) {
+Contact integrals_of_intersection(const Simplex<dim>& a, const Simplex<dim>& b,
+                                  IntersectionWorkspace<dim>& workspace, LocalIntegrals<dim>& out) {
   using Kind = typename Overlap<dim>::Kind;
   const Overlap<dim> overlap = find_overlap(a, b, workspace.polytope);
   const Simplex<dim>& small = *overlap.small;
@@ -223,7 +226,7 @@ bool integrals_of_intersection(const Simplex<dim>& a, const Simplex<dim>& b,
   switch (overlap.kind) {
     case Kind::empty:
       out = {};
-      return false;
+      return overlap.separated ? Contact::separated : Contact::touching;
     case Kind::small_inside: {  // Ω = S: ∫_S λ^S_i λ^L_j = |S| (β_ji + Σ_k β_jk) / ((d+1)(d+2))
       moments = simplex_moments(small);
       for (int j = 0; j <= dim; ++j) {
@@ -287,7 +290,7 @@ bool integrals_of_intersection(const Simplex<dim>& a, const Simplex<dim>& b,
   const double scale = admissible_scale(moments.measure, a, b);
   if (scale == 0.0) {
     out = {};
-    return false;
+    return Contact::touching;
   }
   out.moments = moments;
   out.moments.measure *= scale;
@@ -299,7 +302,7 @@ bool integrals_of_intersection(const Simplex<dim>& a, const Simplex<dim>& b,
     for (int j = 0; j <= dim; ++j)
       out.mass[i][j] = scale * (overlap.a_is_small ? mass[i][j] : mass[j][i]);
   }
-  return true;
+  return Contact::overlapping;
 }
 
 template <int dim>
@@ -347,10 +350,18 @@ bool intersection_moments(const Simplex<3>& a, const Simplex<3>& b,
 
 bool local_integrals(const Simplex<2>& a, const Simplex<2>& b, IntersectionWorkspace<2>& workspace,
                      LocalIntegrals<2>& out) {
-  return integrals_of_intersection(a, b, workspace, out);
+  return integrals_of_intersection(a, b, workspace, out) == Contact::overlapping;
 }
 bool local_integrals(const Simplex<3>& a, const Simplex<3>& b, IntersectionWorkspace<3>& workspace,
                      LocalIntegrals<3>& out) {
+  return integrals_of_intersection(a, b, workspace, out) == Contact::overlapping;
+}
+Contact local_integrals_contact(const Simplex<2>& a, const Simplex<2>& b,
+                                IntersectionWorkspace<2>& workspace, LocalIntegrals<2>& out) {
+  return integrals_of_intersection(a, b, workspace, out);
+}
+Contact local_integrals_contact(const Simplex<3>& a, const Simplex<3>& b,
+                                IntersectionWorkspace<3>& workspace, LocalIntegrals<3>& out) {
   return integrals_of_intersection(a, b, workspace, out);
 }
 

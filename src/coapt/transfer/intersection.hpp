@@ -70,6 +70,13 @@ struct LocalIntegrals {
   double measure() const { return moments.measure; }
 };
 
+/// What the kernel's rejection tests say of a pair (A, B).
+enum class Contact {
+  separated,    ///< degenerate element, disjoint boxes or a separating face plane (step 1–4)
+  touching,     ///< passed those tests, but |A∩B| has zero measure (edge–edge contact, ...)
+  overlapping,  ///< |A∩B| > 0: local_integrals() returns true
+};
+
 /// Moments of A ∩ B (measure, centroid, central second moment). Returns false, with `out`
 /// zeroed, when the intersection has zero measure.
 bool intersection_moments(const Simplex<2>& a, const Simplex<2>& b,
@@ -83,6 +90,14 @@ bool local_integrals(const Simplex<2>& a, const Simplex<2>& b, IntersectionWorks
                      LocalIntegrals<2>& out);
 bool local_integrals(const Simplex<3>& a, const Simplex<3>& b, IntersectionWorkspace<3>& workspace,
                      LocalIntegrals<3>& out);
+
+/// local_integrals(), also telling a pair the rejection tests dropped (Contact::separated: no
+/// part of A∩B of positive measure, the advancing front does not cross it) from one that passed
+/// them but has zero measure. `out` as local_integrals(); overlapping ⇔ local_integrals() true.
+Contact local_integrals_contact(const Simplex<2>& a, const Simplex<2>& b,
+                                IntersectionWorkspace<2>& workspace, LocalIntegrals<2>& out);
+Contact local_integrals_contact(const Simplex<3>& a, const Simplex<3>& b,
+                                IntersectionWorkspace<3>& workspace, LocalIntegrals<3>& out);
 
 /// Quadrature on A ∩ B exact for polynomials of degree ≤ 2: physical points [m] and
 /// positive weights [m^dim] summing to |A∩B| (a degree-2 rule per sub-simplex of a fan
