@@ -58,6 +58,9 @@ struct IntersectionWorkspace {
   static constexpr int max_quadrature_points = Polytope::max_quadrature_points;
   Polytope polytope;
   std::array<QuadraturePoint<dim>, max_quadrature_points> quadrature{};
+  /// false: local_integrals() leaves LocalIntegrals::moments.second zero (a caller that only
+  /// needs the integrals saves the physical second moment; the integrals do not use it).
+  bool second_moment = true;
 };
 
 /// The local integrals of the transfer operators for one pair (A, B), over A ∩ B.
@@ -67,6 +70,10 @@ struct LocalIntegrals {
   NodalVector<dim> integral_a{};  ///< ∫ λ^A_i [m^dim]
   NodalVector<dim> integral_b{};  ///< ∫ λ^B_j [m^dim]
   NodalMatrix<dim> mass{};        ///< M_ij = ∫ λ^A_i λ^B_j [m^dim], row i: A, column j: B
+  /// Bit j set: some vertex of A lies strictly beyond face plane j of B (λ^B_j < −tol), or it
+  /// is not known (all bits); set by local_integrals_contact() for every pair not separated,
+  /// from the kernel's own β / γ (the advancing front crosses only these faces of B).
+  unsigned crossed_faces_b = ~0u;
   double measure() const { return moments.measure; }
 };
 

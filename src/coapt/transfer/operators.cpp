@@ -87,12 +87,14 @@ class Engine final : public TransferEngine {
     out.full.assign(static_cast<std::size_t>(n_rows), 0.0);
     out.mass_cells.clear();
     out.mass_blocks.clear();
+    workspace_.second_moment = standard;  // mass_matrix() needs it, B and D do not
     std::size_t n_hits = 0;  // integrals of the current cell's overlapping pairs in buffer_
 
-    const auto test = [&](int, const Simplex<dim>& s, int m) {
+    const auto test = [&](int, const Simplex<dim>& s, int m, unsigned& crossed) {
       if (n_hits == buffer_.size()) buffer_.resize(2 * n_hits + 32);
       const Contact contact =
           local_integrals_contact(s, master_simplices[m], workspace_, buffer_[n_hits]);
+      crossed = buffer_[n_hits].crossed_faces_b;
       if (contact == Contact::overlapping) ++n_hits;
       return contact;
     };

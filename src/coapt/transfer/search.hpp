@@ -311,9 +311,11 @@ class PairSearch {
   MPI_Comm comm() const { return comm_; }
 
   /// Advancing front over the owned slave cells (SearchOptions::front only), in order c = 0,
-  /// 1, ...: test(c, s, m) → Contact is called at most once per (c, m) with s the simplex of
-  /// slave cell c, then finish(c, s, overlapping) with the master cells it found overlapping
-  /// (every owned cell, in order; also stored as pairs_of(c)).
+  /// 1, ...: test(c, s, m, crossed) → Contact is called at most once per (c, m) with s the
+  /// simplex of slave cell c, then finish(c, s, overlapping) with the master cells it found
+  /// overlapping (every owned cell, in order; also stored as pairs_of(c)). `crossed` comes in
+  /// with all bits set; the test may clear bit i when no vertex of s lies strictly beyond face
+  /// plane i of master cell m (λ_i ≥ −kPlaneTolerance: LocalIntegrals::crossed_faces_b).
   ///
   /// Per slave cell S: the front starts from the master cells that the first earlier face
   /// neighbour of S with any overlaps found, and crosses every face of every master cell the
@@ -327,6 +329,8 @@ class PairSearch {
   /// overlapping cell (no seed, disconnected pieces, S outside M) or when some crossed cell
   /// has an open face whose plane S crosses (a vertex of S at λ < −kPlaneTolerance):
   /// the master's boundary, a face to a cell this rank did not receive, a non-conforming face.
+  /// The same argument lets the front skip the faces of a cell whose plane S does not cross:
+  /// a segment in int S never goes through them.
   template <class Test, class Finish>
   void sweep(Test&& test, Finish&& finish);
   /// Frees the pair list and the front's scratch (pairs_of() is empty afterwards); for a
@@ -460,11 +464,13 @@ void PairSearch<dim>::sweep(Test&& test, Finish&& finish) {
       for (std::size_t q = 0; q < queue_.size(); ++q) {
         const int m = queue_[q];
         ++tests;
-        const Contact contact = test(c, s, m);
+        unsigned crossed = ~0u;
+        const Contact contact = test(c, s, m, crossed);
         if (contact == Contact::separated) continue;
         if (contact == Contact::overlapping) scratch_.push_back(m);
         const int* across = master_neighbors_.data() + static_cast<std::size_t>(m) * k;
         for (int i = 0; i < k; ++i) {
+          if (!((crossed >> i) & 1u)) continue;  // S does not cross this face's plane
           const int n = across[i];
           if (n >= 0) {
             if (visited_[n] != c) {
@@ -484,7 +490,8 @@ void PairSearch<dim>::sweep(Test&& test, Finish&& finish) {
           if (visited_[m] == c) return;
           visited_[m] = c;
           ++tests;
-          if (test(c, s, m) == Contact::overlapping) scratch_.push_back(m);
+          unsigned crossed = ~0u;
+          if (test(c, s, m, crossed) == Contact::overlapping) scratch_.push_back(m);
         });
       }
     }
