@@ -476,6 +476,10 @@ void PairSearch<dim>::sweep(Test&& test, Finish&& finish) {
             if (visited_[n] != c) {
               visited_[n] = c;
               queue_.push_back(n);
+              // The kernel first reads the measure and the box, at the end of the simplex:
+              // fetch that line now, so the load that used to miss is in cache when n is
+              // tested (was ~3 % of the sweep in CPU samples).
+              __builtin_prefetch(&master_simplices_[n].measure);
             }
           } else if (!open) {
             const Simplex<dim>& t = master_simplices_[m];
