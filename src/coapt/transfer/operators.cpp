@@ -117,6 +117,27 @@ class Engine final : public TransferEngine {
       for (int a = 0; a < k; ++a)
         for (std::size_t e = 0; e < row[a]->columns.size(); ++e)
           stamp(row[a]->columns[e])[a] = static_cast<int>(e);
+      // Pass 1: an entry for every (row, column) the cell's pairs reach (rows only grow here).
+      for (std::size_t q = 0; q < n_hits; ++q) {
+        const int* columns = received.cells.data() + static_cast<std::size_t>(pairs[q]) * k;
+        for (int b = 0; b < k; ++b) {
+          int* slot = stamp(columns[b]);
+          for (int a = 0; a < k; ++a) {
+            if (slot[a] >= 0) continue;
+            Row& r = *row[a];
+            slot[a] = static_cast<int>(r.columns.size());
+            r.columns.push_back(columns[b]);
+            r.dual.push_back(0.0);
+            if (standard) r.primal.push_back(0.0);
+          }
+        }
+      }
+      // Pass 2: the sums, through stable pointers (no branch, no reload per add).
+      std::array<double*, k> dual_row, primal_row{};
+      for (int a = 0; a < k; ++a) {
+        dual_row[a] = row[a]->dual.data();
+        if (standard) primal_row[a] = row[a]->primal.data();
+      }
       NodalMatrix<dim> mass_block{};
       for (std::size_t q = 0; q < n_hits; ++q) {
         const LocalIntegrals<dim>& local = buffer_[q];
@@ -124,18 +145,10 @@ class Engine final : public TransferEngine {
         const NodalVector<dim> dual_integral = dual_integrals(local);
         const int* columns = received.cells.data() + static_cast<std::size_t>(pairs[q]) * k;
         for (int b = 0; b < k; ++b) {
-          int* slot = stamp(columns[b]);
-          for (int a = 0; a < k; ++a) {
-            Row& r = *row[a];
-            if (slot[a] < 0) {
-              slot[a] = static_cast<int>(r.columns.size());
-              r.columns.push_back(columns[b]);
-              r.dual.push_back(0.0);
-              if (standard) r.primal.push_back(0.0);
-            }
-            r.dual[static_cast<std::size_t>(slot[a])] += dual[a][b];
-            if (standard) r.primal[static_cast<std::size_t>(slot[a])] += local.mass[a][b];
-          }
+          const int* slot = slots_.data() + static_cast<std::size_t>(columns[b]) * k;
+          for (int a = 0; a < k; ++a) dual_row[a][slot[a]] += dual[a][b];
+          if (standard)
+            for (int a = 0; a < k; ++a) primal_row[a][slot[a]] += local.mass[a][b];
         }
         for (int a = 0; a < k; ++a) {
           out.dual_integral[vertices[a]] += dual_integral[a];

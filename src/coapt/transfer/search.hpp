@@ -37,7 +37,9 @@
 ///
 /// Memory per rank: received master cells (dim + 1 ints) and vertices (global number and
 /// coordinates), one Simplex per received master cell, the grid (a few ints per received
-/// cell), one int per pair, and three ints per owned slave cell.
+/// cell), one int per pair, and three ints per owned slave cell; with the front, dim + 1
+/// face neighbours per owned slave cell and per received master cell, and one int per
+/// received master cell (the front's marks).
 
 #include <mpi.h>
 #include <petscsys.h>

@@ -5,7 +5,9 @@
 // the meshes overlap in one piece. Also face_neighbors against a direct count.
 
 #include <gtest/gtest.h>
+#include <petscmat.h>
 
+#include <cmath>
 #include <cstdint>
 #include <map>
 #include <set>
@@ -14,6 +16,7 @@
 #include "../../support/mesh_transforms.hpp"
 #include "coapt/mesh/generators.hpp"
 #include "coapt/transfer/intersection.hpp"
+#include "coapt/transfer/operators.hpp"
 #include "coapt/transfer/search.hpp"
 
 namespace coapt::transfer {
@@ -188,6 +191,76 @@ TEST(TransferFront, SamePairsAsGrid3D) {
   // the slave coarser than the master
   expect_front_matches_grid<3>(box(0, 0, 0, 1, 1, 1, 2, 2, 2),
                                rotated(box(0.1, 0.1, 0.1, 0.9, 0.9, 0.9, 7, 7, 7), 0.3, {1, 2, 3}));
+}
+
+/// B and D of VariationalTransfer (front) against a reference sum over the grid's pair list
+/// (the previous pipeline: filter, kernel, then (d+1)² adds per overlapping pair): the same
+/// pattern, entries equal to round-off (relative to the row's scale), D likewise.
+template <int dim>
+void expect_operators_match_grid(const Mesh& slave, const Mesh& master) {
+  constexpr int k = dim + 1;
+  PairSearch<dim> grid(slave, master);
+  std::map<std::pair<PetscInt, PetscInt>, double> b;
+  std::map<PetscInt, double> d;
+  IntersectionWorkspace<dim> workspace;
+  LocalIntegrals<dim> local;
+  for (int c = 0; c < slave.n_owned_cells; ++c) {
+    const Simplex<dim> s = cell_simplex<dim>(slave, c);
+    for (int m : grid.pairs_of(c)) {
+      if (!local_integrals(s, grid.master_simplices()[m], workspace, local)) continue;
+      const NodalMatrix<dim> dual = dual_mass(local);
+      const NodalVector<dim> dual_integral = dual_integrals(local);
+      for (int a = 0; a < k; ++a) {
+        const PetscInt row = slave.global_vertex[slave.cell(c)[a]];
+        d[row] += dual_integral[a];
+        for (int j = 0; j < k; ++j)
+          b[{row, grid.master().vertex_global[grid.master().cells[m * k + j]]}] += dual[a][j];
+      }
+    }
+  }
+  VariationalTransfer t(slave, master);
+  std::size_t n_entries = 0;
+  double worst = 0;
+  PetscInt lo = 0, hi = 0;
+  MatGetOwnershipRange(t.coupling(), &lo, &hi);
+  for (PetscInt r = lo; r < hi; ++r) {
+    PetscInt n = 0;
+    const PetscInt* columns = nullptr;
+    const PetscScalar* values = nullptr;
+    MatGetRow(t.coupling(), r, &n, &columns, &values);
+    double scale = 0;
+    for (PetscInt e = 0; e < n; ++e) scale += std::fabs(values[e]);
+    for (PetscInt e = 0; e < n; ++e) {
+      const auto it = b.find({r, columns[e]});
+      if (it == b.end()) {
+        ADD_FAILURE() << "entry (" << r << ", " << columns[e] << ") not in the reference";
+        continue;
+      }
+      worst = std::max(worst, std::fabs(values[e] - it->second) / scale);
+    }
+    n_entries += static_cast<std::size_t>(n);
+    MatRestoreRow(t.coupling(), r, &n, &columns, &values);
+  }
+  EXPECT_EQ(n_entries, b.size());  // no reference entry missing
+  EXPECT_LT(worst, 1e-14);
+  const PetscScalar* dual = nullptr;
+  VecGetArrayRead(t.dual_mass(), &dual);
+  for (PetscInt r = lo; r < hi; ++r) {
+    const double reference = d.count(r) ? d[r] : 0.0;
+    EXPECT_NEAR(dual[r - lo], reference, 1e-14 * std::fabs(reference) + 1e-300) << "row " << r;
+  }
+  VecRestoreArrayRead(t.dual_mass(), &dual);
+}
+
+TEST(TransferFront, OperatorsMatchGridPairList) {
+  const Mesh slave3 = box(0, 0, 0, 1, 1, 1, 5, 5, 5);
+  expect_operators_match_grid<3>(slave3, jittered(slave3, 0.2, 0.1));
+  expect_operators_match_grid<3>(
+      slave3, rotated(box(0.3, -0.2, 0.1, 1.2, 0.8, 1.3, 6, 7, 8), 0.4, {1, 1, 0}));
+  const Mesh slave2 = square(0, 0, 1, 1, 10, 10);
+  expect_operators_match_grid<2>(slave2, jittered(slave2, 0.1, 0.1));
+  expect_operators_match_grid<2>(slave2,
+                                 without_slab(rotated(square(0, 0, 1, 1, 7, 7), 0.2), 0, 0.4, 0.6));
 }
 
 }  // namespace
