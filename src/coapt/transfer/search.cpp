@@ -57,8 +57,8 @@ std::vector<int> face_neighbors(int dim, std::span<const int> cells, int n_verti
   const int k = dim + 1;
   const std::size_t n_faces = cells.size();  // one per (cell, opposite vertex)
   std::vector<int> across(n_faces, -1);
-  // Faces as sorted vertex tuples, bucketed by their smallest vertex (counting sort): a face
-  // has one match at most among the few faces of its bucket.
+  // Faces as sorted vertex tuples, bucketed by their smallest vertex (counting sort): the
+  // cell across a face is the other cell with the same tuple, in the same bucket.
   struct Face {
     std::array<int, 2> rest{};  // the other vertices, ascending (dim = 2: rest[1] = -1)
     int id = 0;                 // c·k + i
@@ -96,16 +96,19 @@ std::vector<int> face_neighbors(int dim, std::span<const int> cells, int n_verti
       sorted[static_cast<std::size_t>(fill[static_cast<std::size_t>(lowest)]++)] = faces[id];
     }
   }
+  // Within a bucket, sort by the other vertices: equal faces become adjacent (a bucket holds
+  // tens of faces, so this beats comparing all pairs in it).
   for (int v = 0; v < n_vertices; ++v) {
-    const int begin = offsets[v], end = offsets[v + 1];
-    for (int a = begin; a < end; ++a) {
-      int match = -1, count = 0;
-      for (int b = begin; b < end; ++b)
-        if (b != a && sorted[b].rest == sorted[a].rest) {
-          match = b;
-          ++count;
-        }
-      if (count == 1) across[static_cast<std::size_t>(sorted[a].id)] = sorted[match].id / k;
+    const auto begin = sorted.begin() + offsets[v], end = sorted.begin() + offsets[v + 1];
+    std::sort(begin, end, [](const Face& a, const Face& b) { return a.rest < b.rest; });
+    for (auto a = begin; a != end;) {
+      auto b = a + 1;
+      while (b != end && b->rest == a->rest) ++b;
+      if (b - a == 2) {  // a face shared by exactly two cells
+        across[static_cast<std::size_t>(a->id)] = (a + 1)->id / k;
+        across[static_cast<std::size_t>((a + 1)->id)] = a->id / k;
+      }
+      a = b;
     }
   }
   return across;

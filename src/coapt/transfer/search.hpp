@@ -247,7 +247,7 @@ class BoxGrid {
 /// Face neighbours of the cells of a simplicial mesh: entry c·(dim + 1) + i is the cell across
 /// the face opposite vertex i of cell c, or −1 (boundary face, or a face shared by more than
 /// two cells: left open). `cells`: n_cells × (dim + 1) vertex indices in [0, n_vertices).
-/// Linear time (faces bucketed by their smallest vertex).
+/// Faces are bucketed by their smallest vertex (counting sort), then sorted within a bucket.
 std::vector<int> face_neighbors(int dim, std::span<const int> cells, int n_vertices);
 
 /// Options of the pair search.
