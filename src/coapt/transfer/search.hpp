@@ -332,7 +332,9 @@ class PairSearch {
   /// has an open face whose plane S crosses (a vertex of S at λ < −kPlaneTolerance):
   /// the master's boundary, a face to a cell this rank did not receive, a non-conforming face.
   /// The same argument lets the front skip the faces of a cell whose plane S does not cross:
-  /// a segment in int S never goes through them.
+  /// a segment in int S never goes through them. A degenerate master cell has no interior for
+  /// the segment to cross, but its faces may be the only link between two overlapping cells, so
+  /// the front crosses all its faces.
   template <class Test, class Finish>
   void sweep(Test&& test, Finish&& finish);
   /// Frees the pair list and the front's scratch (pairs_of() is empty afterwards); for a
@@ -468,7 +470,12 @@ void PairSearch<dim>::sweep(Test&& test, Finish&& finish) {
         ++tests;
         unsigned crossed = ~0u;
         const Contact contact = test(c, s, m, crossed);
-        if (contact == Contact::separated) continue;
+        if (contact == Contact::separated) {
+          // A degenerate (flat) master cell is "separated" from everything but may sit between
+          // two cells that overlap S: the front walks through it.
+          if (!master_simplices_[m].degenerate()) continue;
+          crossed = ~0u;
+        }
         if (contact == Contact::overlapping) scratch_.push_back(m);
         const int* across = master_neighbors_.data() + static_cast<std::size_t>(m) * k;
         for (int i = 0; i < k; ++i) {

@@ -193,6 +193,52 @@ TEST(TransferFront, SamePairsAsGrid3D) {
                                rotated(box(0.1, 0.1, 0.1, 0.9, 0.9, 0.9, 7, 7, 7), 0.3, {1, 2, 3}));
 }
 
+/// Two triangles of the unit square linked only through two flat (degenerate) triangles: the
+/// second triangle gets its own copies p', q' of the shared diagonal's vertices, and the flat
+/// cells (p, q, q'), (p, q', p') join the diagonal (p, q) to (p', q'). Every cell's box is that
+/// of a proper cell, and the front must walk through the flat cells to reach the other half.
+Mesh linked_by_flat_cells() {
+  Mesh m = square(0, 0, 1, 1, 1, 1);
+  EXPECT_EQ(m.n_cells(), 2);
+  std::vector<int> shared;
+  for (int v : m.cell(0))
+    for (int w : m.cell(1))
+      if (v == w) shared.push_back(v);
+  EXPECT_EQ(shared.size(), 2u);
+  const int p = shared[0], q = shared[1];
+  const int p2 = m.n_vertices(), q2 = p2 + 1;
+  for (int v : {p, q}) {
+    m.coordinates.push_back(m.point(v)[0]);
+    m.coordinates.push_back(m.point(v)[1]);
+    m.global_vertex.push_back(static_cast<PetscInt>(m.global_vertex.size()));
+    if (!m.original_vertex.empty()) m.original_vertex.push_back(m.original_vertex.back() + 1);
+  }
+  m.n_owned_vertices = m.n_vertices();
+  m.n_global_vertices = m.n_vertices();
+  for (int a = 3; a < 6; ++a) {
+    if (m.cells[a] == p)
+      m.cells[a] = p2;
+    else if (m.cells[a] == q)
+      m.cells[a] = q2;
+  }
+  for (int v : {p, q, q2, p, q2, p2}) m.cells.push_back(v);
+  for (int c = 0; c < 2; ++c) {
+    if (!m.cell_tags.empty()) m.cell_tags.push_back(m.cell_tags[0]);
+    if (!m.original_cell.empty()) m.original_cell.push_back(m.original_cell.back() + 1);
+  }
+  m.n_owned_cells = m.n_cells();
+  m.n_global_cells = m.n_cells();
+  return m;
+}
+
+TEST(TransferFront, WalksThroughFlatCells) {
+  const Mesh master = linked_by_flat_cells();
+  const std::vector<int> across = face_neighbors(2, master.cells, master.n_vertices());
+  for (int i = 0; i < 3; ++i) EXPECT_NE(across[i], 1);  // the halves share no edge
+  const Mesh slave = rotated(square(0.05, 0.05, 0.95, 0.95, 6, 6), 0.1);
+  expect_front_matches_grid<2>(slave, master);
+}
+
 /// B and D of VariationalTransfer (front) against a reference sum over the grid's pair list
 /// (the previous pipeline: filter, kernel, then (d+1)² adds per overlapping pair): the same
 /// pattern, entries equal to round-off (relative to the row's scale), D likewise.
