@@ -146,6 +146,7 @@ io::Json transfer(const Context& context, const TransferBenchOptions& options) {
     figures[prefix + "max_pairs_on_a_rank"] = max_pairs;
     figures[prefix + "candidate_pairs"] = sum_over_ranks(comm, s.search.candidate_pairs);
     figures[prefix + "filtered_pairs"] = sum_over_ranks(comm, s.search.pairs);
+    figures[prefix + "front_fallbacks"] = sum_over_ranks(comm, s.search.front_fallbacks);
     figures[prefix + "received_master_cells"] =
         sum_over_ranks(comm, s.search.received_master_cells);
     figures[prefix + "search_seconds"] = search;
@@ -160,11 +161,12 @@ io::Json transfer(const Context& context, const TransferBenchOptions& options) {
     figures[prefix + "search_reused"] = !s.search.full;
     figures[prefix + "pattern_reused"] = s.pattern_reused;
     log::info(
-        "{}{} intersecting pairs ({} box candidates, {} after the plane filter); search {:.3f} s, "
-        "intersection {:.3f} s, assembly {:.3f} s, total {:.3f} s: {:.3g} pairs/s per rank "
-        "({:.3g} in the intersection alone); search reused: {}, pattern reused: {}",
+        "{}{} intersecting pairs ({} pairs tested by the front, {} slave cells fell back to the "
+        "grid); search {:.3f} s, front + intersection {:.3f} s, assembly {:.3f} s, total {:.3f} s: "
+        "{:.3g} pairs/s per rank ({:.3g} in the front + intersection alone); search reused: {}, "
+        "pattern reused: {}",
         prefix, pairs, figures[prefix + "candidate_pairs"].dump(),
-        figures[prefix + "filtered_pairs"].dump(), search, intersection, assembly, wall,
+        figures[prefix + "front_fallbacks"].dump(), search, intersection, assembly, wall,
         per_rank / wall, per_rank / intersection, !s.search.full, s.pattern_reused);
   };
   record("", first_seconds);

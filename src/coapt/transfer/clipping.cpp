@@ -53,8 +53,8 @@ Side classify(const HalfSpace<dim>& half_space, const Points& points, int n, dou
     double d = half_space.distance(points[k]);
     if (std::fabs(d) <= tolerance) d = 0.0;
     distance[k] = d;
-    any_inside = any_inside || d > 0.0;
-    any_outside = any_outside || d < 0.0;
+    any_inside |= d > 0.0;  // | not ||: no branch per vertex
+    any_outside |= d < 0.0;
   }
   if (!any_outside) return Side::inside;
   return any_inside ? Side::cut : Side::outside;

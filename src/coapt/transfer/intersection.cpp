@@ -60,6 +60,8 @@ template <int dim>
 struct Overlap {
   enum class Kind { empty, small_inside, large_inside, clipped };
   Kind kind = Kind::empty;
+  bool separated = true;     ///< empty by the rejection tests (false: passed them)
+  unsigned b_crossed = ~0u;  ///< bit j: a vertex of A has λ^B_j < −tol (all bits: not known)
   bool a_is_small = true;
   const Simplex<dim>* small = nullptr;  ///< S (A until the pair is classified)
   const Simplex<dim>* large = nullptr;  ///< L
@@ -97,13 +99,16 @@ Overlap<dim> find_overlap(const Simplex<dim>& a, const Simplex<dim>& b, Polytope
     if (!(highest > tol)) return overlap;  // separating plane
     if (lowest < -tol) cutting |= 1u << j;
   }
+  if (overlap.a_is_small) overlap.b_crossed = cutting;  // B = L
   if (cutting == 0) {
+    overlap.separated = false;
     overlap.kind = Kind::small_inside;
     return overlap;
   }
 
   // 4. faces of S against the vertices of L
   bool large_inside = true;
+  unsigned crossed = 0;  // faces of S crossed by L
   for (int i = 0; i <= dim; ++i) {
     double lowest = std::numeric_limits<double>::infinity(), highest = -lowest;
     for (int k = 0; k <= dim; ++k) {
@@ -113,8 +118,13 @@ Overlap<dim> find_overlap(const Simplex<dim>& a, const Simplex<dim>& b, Polytope
       highest = d > highest ? d : highest;
     }
     if (!(highest > tol)) return overlap;
-    if (lowest < -tol) large_inside = false;
+    if (lowest < -tol) {
+      large_inside = false;
+      crossed |= 1u << i;
+    }
   }
+  if (!overlap.a_is_small) overlap.b_crossed = crossed;  // B = S
+  overlap.separated = false;
   if (large_inside) {
     overlap.kind = Kind::large_inside;
     return overlap;
@@ -150,11 +160,13 @@ Point<dim> to_physical(const Simplex<dim>& s, const Point<dim>& xi) {
 // Physical moments of a region given by its moments in the reference coordinates of s:
 // |Ω| = d!|S| V_ξ, x̄ = x(ξ̄), ∫(x − x̄)(x − x̄)ᵀ = d!|S| J C_ξ Jᵀ.
 template <int dim>
-Moments<dim> physical_moments(const Simplex<dim>& s, const Moments<dim>& reference) {
+Moments<dim> physical_moments(const Simplex<dim>& s, const Moments<dim>& reference,
+                              bool second = true) {
   const double jacobian = factorial(dim) * s.measure;
   Moments<dim> m;
   m.measure = jacobian * reference.measure;
   m.centroid = to_physical<dim>(s, reference.centroid);
+  if (!second) return m;
   std::array<Point<dim>, dim> jc{};  // J C_ξ
   for (int r = 0; r < dim; ++r)
     for (int c = 0; c < dim; ++c)
@@ -166,6 +178,16 @@ Moments<dim> physical_moments(const Simplex<dim>& s, const Moments<dim>& referen
       for (int k = 0; k < dim; ++k) value += jc[r][k] * (s.vertices[k + 1][c] - s.vertices[0][c]);
       m.second[r][c] = jacobian * value;
     }
+  return m;
+}
+
+// Measure and vertex centroid of a simplex (simplex_moments without the second moment).
+template <int dim>
+Moments<dim> first_moments(const Simplex<dim>& s) {
+  Moments<dim> m;
+  m.measure = s.measure;
+  for (const auto& v : s.vertices)
+    for (int k = 0; k < dim; ++k) m.centroid[k] += v[k] / (dim + 1);
   return m;
 }
 
@@ -210,8 +232,8 @@ bool moments_of_intersection(const Simplex<dim>& a, const Simplex<dim>& b,
 }
 
 template <int dim>
-bool integrals_of_intersection(const Simplex<dim>& a, const Simplex<dim>& b,
-                               IntersectionWorkspace<dim>& workspace, LocalIntegrals<dim>& out) {
+Contact integrals_of_intersection(const Simplex<dim>& a, const Simplex<dim>& b,
+                                  IntersectionWorkspace<dim>& workspace, LocalIntegrals<dim>& out) {
   using Kind = typename Overlap<dim>::Kind;
   const Overlap<dim> overlap = find_overlap(a, b, workspace.polytope);
   const Simplex<dim>& small = *overlap.small;
@@ -223,9 +245,10 @@ bool integrals_of_intersection(const Simplex<dim>& a, const Simplex<dim>& b,
   switch (overlap.kind) {
     case Kind::empty:
       out = {};
-      return false;
+      out.crossed_faces_b = overlap.b_crossed;
+      return overlap.separated ? Contact::separated : Contact::touching;
     case Kind::small_inside: {  // Ω = S: ∫_S λ^S_i λ^L_j = |S| (β_ji + Σ_k β_jk) / ((d+1)(d+2))
-      moments = simplex_moments(small);
+      moments = workspace.second_moment ? simplex_moments(small) : first_moments(small);
       for (int j = 0; j <= dim; ++j) {
         double sum = 0.0;
         for (int k = 0; k <= dim; ++k) sum += overlap.beta[j][k];
@@ -237,7 +260,7 @@ bool integrals_of_intersection(const Simplex<dim>& a, const Simplex<dim>& b,
       break;
     }
     case Kind::large_inside: {  // Ω = L: ∫_L λ^S_i λ^L_j = |L| (γ_ij + Σ_k γ_ik) / ((d+1)(d+2))
-      moments = simplex_moments(large);
+      moments = workspace.second_moment ? simplex_moments(large) : first_moments(large);
       for (int i = 0; i <= dim; ++i) {
         double sum = 0.0;
         for (int k = 0; k <= dim; ++k) sum += overlap.gamma[i][k];
@@ -250,7 +273,7 @@ bool integrals_of_intersection(const Simplex<dim>& a, const Simplex<dim>& b,
     }
     case Kind::clipped: {
       const Moments<dim> reference = workspace.polytope.moments();
-      moments = physical_moments(small, reference);
+      moments = physical_moments(small, reference, workspace.second_moment);
       // ū = λ^S(ξ̄) and the covariance of u = (1 − Σξ, ξ): C_u,kl = C_ξ,kl for k, l ≥ 1,
       // C_u,0l = −Σ_k C_ξ,kl, C_u,00 = Σ_kl C_ξ,kl.
       NodalVector<dim> u_bar;
@@ -287,8 +310,10 @@ bool integrals_of_intersection(const Simplex<dim>& a, const Simplex<dim>& b,
   const double scale = admissible_scale(moments.measure, a, b);
   if (scale == 0.0) {
     out = {};
-    return false;
+    out.crossed_faces_b = overlap.b_crossed;
+    return Contact::touching;
   }
+  out.crossed_faces_b = overlap.b_crossed;
   out.moments = moments;
   out.moments.measure *= scale;
   for (auto& row : out.moments.second)
@@ -299,7 +324,7 @@ bool integrals_of_intersection(const Simplex<dim>& a, const Simplex<dim>& b,
     for (int j = 0; j <= dim; ++j)
       out.mass[i][j] = scale * (overlap.a_is_small ? mass[i][j] : mass[j][i]);
   }
-  return true;
+  return Contact::overlapping;
 }
 
 template <int dim>
@@ -347,10 +372,18 @@ bool intersection_moments(const Simplex<3>& a, const Simplex<3>& b,
 
 bool local_integrals(const Simplex<2>& a, const Simplex<2>& b, IntersectionWorkspace<2>& workspace,
                      LocalIntegrals<2>& out) {
-  return integrals_of_intersection(a, b, workspace, out);
+  return integrals_of_intersection(a, b, workspace, out) == Contact::overlapping;
 }
 bool local_integrals(const Simplex<3>& a, const Simplex<3>& b, IntersectionWorkspace<3>& workspace,
                      LocalIntegrals<3>& out) {
+  return integrals_of_intersection(a, b, workspace, out) == Contact::overlapping;
+}
+Contact local_integrals_contact(const Simplex<2>& a, const Simplex<2>& b,
+                                IntersectionWorkspace<2>& workspace, LocalIntegrals<2>& out) {
+  return integrals_of_intersection(a, b, workspace, out);
+}
+Contact local_integrals_contact(const Simplex<3>& a, const Simplex<3>& b,
+                                IntersectionWorkspace<3>& workspace, LocalIntegrals<3>& out) {
   return integrals_of_intersection(a, b, workspace, out);
 }
 

@@ -58,6 +58,9 @@ struct IntersectionWorkspace {
   static constexpr int max_quadrature_points = Polytope::max_quadrature_points;
   Polytope polytope;
   std::array<QuadraturePoint<dim>, max_quadrature_points> quadrature{};
+  /// false: local_integrals() leaves LocalIntegrals::moments.second zero (a caller that only
+  /// needs the integrals saves the physical second moment; the integrals do not use it).
+  bool second_moment = true;
 };
 
 /// The local integrals of the transfer operators for one pair (A, B), over A ∩ B.
@@ -67,7 +70,18 @@ struct LocalIntegrals {
   NodalVector<dim> integral_a{};  ///< ∫ λ^A_i [m^dim]
   NodalVector<dim> integral_b{};  ///< ∫ λ^B_j [m^dim]
   NodalMatrix<dim> mass{};        ///< M_ij = ∫ λ^A_i λ^B_j [m^dim], row i: A, column j: B
+  /// Bit j set: some vertex of A lies strictly beyond face plane j of B (λ^B_j < −tol), or it
+  /// is not known (all bits); set by local_integrals_contact() for every pair not separated,
+  /// from the kernel's own β / γ (the advancing front crosses only these faces of B).
+  unsigned crossed_faces_b = ~0u;
   double measure() const { return moments.measure; }
+};
+
+/// What the kernel's rejection tests say of a pair (A, B).
+enum class Contact {
+  separated,    ///< degenerate element, disjoint boxes or a separating face plane (step 1–4)
+  touching,     ///< passed those tests, but |A∩B| has zero measure (edge–edge contact, ...)
+  overlapping,  ///< |A∩B| > 0: local_integrals() returns true
 };
 
 /// Moments of A ∩ B (measure, centroid, central second moment). Returns false, with `out`
@@ -83,6 +97,14 @@ bool local_integrals(const Simplex<2>& a, const Simplex<2>& b, IntersectionWorks
                      LocalIntegrals<2>& out);
 bool local_integrals(const Simplex<3>& a, const Simplex<3>& b, IntersectionWorkspace<3>& workspace,
                      LocalIntegrals<3>& out);
+
+/// local_integrals(), also telling a pair the rejection tests dropped (Contact::separated: no
+/// part of A∩B of positive measure, the advancing front does not cross it) from one that passed
+/// them but has zero measure. `out` as local_integrals(); overlapping ⇔ local_integrals() true.
+Contact local_integrals_contact(const Simplex<2>& a, const Simplex<2>& b,
+                                IntersectionWorkspace<2>& workspace, LocalIntegrals<2>& out);
+Contact local_integrals_contact(const Simplex<3>& a, const Simplex<3>& b,
+                                IntersectionWorkspace<3>& workspace, LocalIntegrals<3>& out);
 
 /// Quadrature on A ∩ B exact for polynomials of degree ≤ 2: physical points [m] and
 /// positive weights [m^dim] summing to |A∩B| (a degree-2 rule per sub-simplex of a fan

@@ -1,20 +1,21 @@
 /// @file operators.cpp
 /// Stage 3 of the transfer pipeline: integration over the pairs and PETSc assembly.
 ///
-/// Local sums. The rank's contributions are summed in a CSR over (local slave vertex,
-/// received master vertex) before PETSc sees them. The pattern comes from the pair list
-/// (row r: the vertices of every master cell paired with an owned slave cell around r); the
-/// integration then runs slave cell by slave cell: the positions of the cell's rows are
-/// written into a scratch table indexed by master vertex, so each of the (d+1)² entries of a
-/// pair is one indexed add. Entries no intersecting pair touched (pairs the separating-plane
-/// filter kept but whose intersection is empty) are dropped before assembly, so B holds no
-/// structural zeros. Nothing is allocated per pair or per cell (the scratch only grows).
+/// Search, integration and local sums in one sweep over the owned slave cells (Engine::
+/// integrate, PairSearch::sweep): the advancing front hands each candidate pair to the
+/// intersection kernel, and the integrals of a cell's overlapping pairs are added into
+/// per-row lists over (local slave vertex, received master vertex) that grow as columns
+/// appear, found through a scratch table indexed by master vertex (one indexed add per entry,
+/// no search). Rows are sorted by column at the end, so the pattern depends only on which
+/// pairs overlap; only entries an overlapping pair reaches exist, so B holds no structural
+/// zeros. Nothing is allocated per pair; the row lists grow by doubling.
 
 #include "coapt/transfer/operators.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numeric>
 #include <span>
 #include <string>
 
@@ -24,13 +25,6 @@
 namespace coapt::transfer {
 
 namespace detail {
-
-namespace {
-using Clock = std::chrono::steady_clock;
-double seconds_between(Clock::time_point a, Clock::time_point b) {
-  return std::chrono::duration<double>(b - a).count();
-}
-}  // namespace
 
 /// What one integration produces on a rank (dimension-free).
 struct LocalOperators {
@@ -60,18 +54,7 @@ template <int dim>
 class Engine final : public TransferEngine {
  public:
   Engine(const mesh::Mesh& slave, const mesh::Mesh& master, const SearchOptions& options)
-      : search_(slave, master, options) {
-    // owned cells around each local slave vertex (the slave does not move)
-    const int n = slave.n_vertices();
-    vertex_cell_offsets_.assign(static_cast<std::size_t>(n) + 1, 0);
-    for (int c = 0; c < slave.n_owned_cells; ++c)
-      for (int v : slave.cell(c)) ++vertex_cell_offsets_[v + 1];
-    for (int v = 0; v < n; ++v) vertex_cell_offsets_[v + 1] += vertex_cell_offsets_[v];
-    vertex_cells_.resize(static_cast<std::size_t>(vertex_cell_offsets_.back()));
-    std::vector<int> fill(vertex_cell_offsets_.begin(), vertex_cell_offsets_.end() - 1);
-    for (int c = 0; c < slave.n_owned_cells; ++c)
-      for (int v : slave.cell(c)) vertex_cells_[fill[v]++] = c;
-  }
+      : search_(slave, master, options) {}
 
   bool update_master(const mesh::Mesh& master) override { return search_.update_master(master); }
   const SearchStatistics& search_statistics() const override { return search_.statistics(); }
@@ -79,6 +62,15 @@ class Engine final : public TransferEngine {
     return search_.master().vertex_global;
   }
 
+  // The search and the integration in one sweep (PairSearch::sweep): the advancing front
+  // tests each candidate pair with the intersection kernel itself, whose rejection tests are
+  // the front's (a separated pair is not crossed) and whose integrals of an overlapping pair
+  // are kept until the slave cell is done. Then the cell's pairs are added into the rows of
+  // its vertices: row r is a list of (received master vertex, value) that grows as new
+  // columns appear (found through slots_, a table indexed by master vertex that holds, for
+  // the current cell, the position of that column in each of the cell's rows); at the end
+  // each row is sorted by column, so the pattern does not depend on the order the pairs
+  // were found in. Only entries an overlapping pair reaches are ever created.
   void integrate(bool standard, LocalOperators& out) override {
     constexpr int k = dim + 1;
     const mesh::Mesh& slave = search_.slave();
@@ -87,84 +79,80 @@ class Engine final : public TransferEngine {
     const int n_rows = slave.n_vertices();
     const int n_columns = received.n_vertices();
 
-    // Pattern: row r gets the vertices of the master cells paired with its owned cells.
-    out.row_offsets.assign(static_cast<std::size_t>(n_rows) + 1, 0);
-    out.columns.clear();
-    stamp_.assign(static_cast<std::size_t>(n_columns), -1);
-    for (int r = 0; r < n_rows; ++r) {
-      const std::size_t first = out.columns.size();
-      for (int a = vertex_cell_offsets_[r]; a < vertex_cell_offsets_[r + 1]; ++a) {
-        for (const int m : search_.pairs_of(vertex_cells_[a])) {
-          const int* vertices = received.cells.data() + static_cast<std::size_t>(m) * k;
-          for (int b = 0; b < k; ++b)
-            if (stamp_[vertices[b]] != r) {
-              stamp_[vertices[b]] = r;
-              out.columns.push_back(vertices[b]);
-            }
-        }
-      }
-      std::sort(out.columns.begin() + static_cast<std::ptrdiff_t>(first), out.columns.end());
-      out.row_offsets[r + 1] = static_cast<int>(out.columns.size());
-    }
-    const std::size_t n_entries = out.columns.size();
-    out.dual.assign(n_entries, 0.0);
-    if (standard)
-      out.primal.assign(n_entries, 0.0);
-    else
-      out.primal.clear();
-    touched_.assign(n_entries, 0);
+    rows_.assign(static_cast<std::size_t>(n_rows), Row{});
+    slot_stamp_.assign(static_cast<std::size_t>(n_columns), -1);
+    slots_.resize(static_cast<std::size_t>(n_columns) * k);
     out.dual_integral.assign(static_cast<std::size_t>(n_rows), 0.0);
     out.covered.assign(static_cast<std::size_t>(n_rows), 0.0);
     out.full.assign(static_cast<std::size_t>(n_rows), 0.0);
     out.mass_cells.clear();
     out.mass_blocks.clear();
-    slots_.resize(static_cast<std::size_t>(n_columns) * k);
-    out.intersecting_pairs = 0;
-    double intersection_seconds = 0;
+    workspace_.second_moment = standard;  // mass_matrix() needs it, B and D do not
+    std::size_t n_hits = 0;  // integrals of the current cell's overlapping pairs in buffer_
 
-    for (int c = 0; c < slave.n_owned_cells; ++c) {
-      const Simplex<dim> s = cell_simplex<dim>(slave, c);
-      const int* rows = slave.cells.data() + static_cast<std::size_t>(c) * k;
-      for (int a = 0; a < k; ++a) out.full[rows[a]] += s.measure / k;
-      const std::span<const int> pairs = search_.pairs_of(c);
-      const std::size_t n_pairs = pairs.size();
-      if (n_pairs == 0) continue;
-      if (buffer_.size() < n_pairs) {
-        buffer_.resize(n_pairs);
-        hit_.resize(n_pairs);
-      }
-      // intersections
-      const Clock::time_point start = Clock::now();
-      for (std::size_t q = 0; q < n_pairs; ++q)
-        hit_[q] = local_integrals(s, master_simplices[pairs[q]], workspace_, buffer_[q]);
-      const Clock::time_point integrated = Clock::now();
-      intersection_seconds += seconds_between(start, integrated);
-      // sums
+    const auto test = [&](int, const Simplex<dim>& s, int m, unsigned& crossed) {
+      if (n_hits == buffer_.size()) buffer_.resize(2 * n_hits + 32);
+      const Contact contact =
+          local_integrals_contact(s, master_simplices[m], workspace_, buffer_[n_hits]);
+      crossed = buffer_[n_hits].crossed_faces_b;
+      if (contact == Contact::overlapping) ++n_hits;
+      return contact;
+    };
+    const auto finish = [&](int c, const Simplex<dim>& s, std::span<const int> pairs) {
+      COAPT_ASSERT(pairs.size() == n_hits, "one integral per overlapping pair");
+      const int* vertices = slave.cells.data() + static_cast<std::size_t>(c) * k;
+      for (int a = 0; a < k; ++a) out.full[vertices[a]] += s.measure / k;
+      if (n_hits == 0) return;
+      std::array<Row*, k> row;
+      for (int a = 0; a < k; ++a) row[a] = &rows_[static_cast<std::size_t>(vertices[a])];
+      // slots of the columns the cell's rows already have
+      const auto stamp = [&](int column) {
+        int* slot = slots_.data() + static_cast<std::size_t>(column) * k;
+        if (slot_stamp_[column] != c) {
+          slot_stamp_[column] = c;
+          for (int a = 0; a < k; ++a) slot[a] = -1;
+        }
+        return slot;
+      };
       for (int a = 0; a < k; ++a)
-        for (int e = out.row_offsets[rows[a]]; e < out.row_offsets[rows[a] + 1]; ++e)
-          slots_[static_cast<std::size_t>(out.columns[e]) * k + a] = e;
+        for (std::size_t e = 0; e < row[a]->columns.size(); ++e)
+          stamp(row[a]->columns[e])[a] = static_cast<int>(e);
+      // Pass 1: an entry for every (row, column) the cell's pairs reach (rows only grow here).
+      for (std::size_t q = 0; q < n_hits; ++q) {
+        const int* columns = received.cells.data() + static_cast<std::size_t>(pairs[q]) * k;
+        for (int b = 0; b < k; ++b) {
+          int* slot = stamp(columns[b]);
+          for (int a = 0; a < k; ++a) {
+            if (slot[a] >= 0) continue;
+            Row& r = *row[a];
+            slot[a] = static_cast<int>(r.columns.size());
+            r.columns.push_back(columns[b]);
+            r.dual.push_back(0.0);
+            if (standard) r.primal.push_back(0.0);
+          }
+        }
+      }
+      // Pass 2: the sums, through stable pointers (no branch, no reload per add).
+      std::array<double*, k> dual_row, primal_row{};
+      for (int a = 0; a < k; ++a) {
+        dual_row[a] = row[a]->dual.data();
+        if (standard) primal_row[a] = row[a]->primal.data();
+      }
       NodalMatrix<dim> mass_block{};
-      bool any = false;
-      for (std::size_t q = 0; q < n_pairs; ++q) {
-        if (!hit_[q]) continue;
-        any = true;
-        ++out.intersecting_pairs;
+      for (std::size_t q = 0; q < n_hits; ++q) {
         const LocalIntegrals<dim>& local = buffer_[q];
         const NodalMatrix<dim> dual = dual_mass(local);
         const NodalVector<dim> dual_integral = dual_integrals(local);
         const int* columns = received.cells.data() + static_cast<std::size_t>(pairs[q]) * k;
         for (int b = 0; b < k; ++b) {
           const int* slot = slots_.data() + static_cast<std::size_t>(columns[b]) * k;
-          for (int a = 0; a < k; ++a) {
-            out.dual[slot[a]] += dual[a][b];
-            touched_[slot[a]] = 1;
-          }
+          for (int a = 0; a < k; ++a) dual_row[a][slot[a]] += dual[a][b];
           if (standard)
-            for (int a = 0; a < k; ++a) out.primal[slot[a]] += local.mass[a][b];
+            for (int a = 0; a < k; ++a) primal_row[a][slot[a]] += local.mass[a][b];
         }
         for (int a = 0; a < k; ++a) {
-          out.dual_integral[rows[a]] += dual_integral[a];
-          out.covered[rows[a]] += local.integral_a[a];
+          out.dual_integral[vertices[a]] += dual_integral[a];
+          out.covered[vertices[a]] += local.integral_a[a];
         }
         if (standard) {
           const NodalMatrix<dim> m = mass_matrix(local.moments, s, s);
@@ -172,47 +160,57 @@ class Engine final : public TransferEngine {
             for (int b = 0; b < k; ++b) mass_block[a][b] += m[a][b];
         }
       }
-      if (standard && any) {
+      if (standard) {
         out.mass_cells.push_back(c);
         for (int a = 0; a < k; ++a)
           for (int b = 0; b < k; ++b) out.mass_blocks.push_back(mass_block[a][b]);
       }
-    }
-    out.intersection_seconds = intersection_seconds;
+      n_hits = 0;
+    };
+    search_.sweep(test, finish);
+    search_.release_pairs();  // memory: the pair list was only needed for the seeds
+    out.intersecting_pairs = search_.statistics().pairs;
+    out.intersection_seconds = search_.statistics().query_seconds;
 
-    // Drop the entries no intersecting pair reached.
-    std::size_t write = 0, read = 0;
+    // Rows sorted by column into the CSR (the row lists are freed as they are copied).
+    out.row_offsets.assign(static_cast<std::size_t>(n_rows) + 1, 0);
+    std::size_t n_entries = 0;
     for (int r = 0; r < n_rows; ++r) {
-      const std::size_t end = static_cast<std::size_t>(out.row_offsets[r + 1]);
-      out.row_offsets[r] = static_cast<int>(write);
-      for (; read < end; ++read)
-        if (touched_[read]) {
-          out.columns[write] = out.columns[read];
-          out.dual[write] = out.dual[read];
-          if (standard) out.primal[write] = out.primal[read];
-          ++write;
-        }
+      n_entries += rows_[static_cast<std::size_t>(r)].columns.size();
+      out.row_offsets[r + 1] = static_cast<int>(n_entries);
     }
-    out.row_offsets[n_rows] = static_cast<int>(write);
-    out.columns.resize(write);
-    out.dual.resize(write);
-    out.columns.shrink_to_fit();
-    out.dual.shrink_to_fit();
-    if (standard) {
-      out.primal.resize(write);
-      out.primal.shrink_to_fit();
+    out.columns.resize(n_entries);
+    out.dual.resize(n_entries);
+    out.primal.resize(standard ? n_entries : 0);
+    std::vector<int> order;
+    for (int r = 0; r < n_rows; ++r) {
+      Row& row = rows_[static_cast<std::size_t>(r)];
+      order.resize(row.columns.size());
+      std::iota(order.begin(), order.end(), 0);
+      std::sort(order.begin(), order.end(),
+                [&](int x, int y) { return row.columns[x] < row.columns[y]; });
+      const std::size_t first = static_cast<std::size_t>(out.row_offsets[r]);
+      for (std::size_t e = 0; e < order.size(); ++e) {
+        out.columns[first + e] = row.columns[order[e]];
+        out.dual[first + e] = row.dual[order[e]];
+        if (standard) out.primal[first + e] = row.primal[order[e]];
+      }
+      row = Row{};
     }
+    rows_ = std::vector<Row>();
   }
 
  private:
   PairSearch<dim> search_;
-  std::vector<int> vertex_cell_offsets_, vertex_cells_;
   // scratch, kept between integrations
-  std::vector<int> stamp_;
-  std::vector<int> slots_;  ///< per received master vertex, the entry of each row of the cell
-  std::vector<unsigned char> touched_;
+  struct Row {  ///< one slave vertex's entries while they are summed, in order of creation
+    std::vector<int> columns;  ///< received master vertex
+    std::vector<double> dual, primal;
+  };
+  std::vector<Row> rows_;
+  std::vector<int> slot_stamp_;  ///< per received master vertex: the cell its slots are for
+  std::vector<int> slots_;       ///< per received master vertex, its entry in each row of the cell
   std::vector<LocalIntegrals<dim>> buffer_;
-  std::vector<unsigned char> hit_;
   IntersectionWorkspace<dim> workspace_;
 };
 
@@ -260,7 +258,9 @@ VariationalTransfer::VariationalTransfer(const mesh::Mesh& slave, const mesh::Me
   if (!(options.coverage_threshold > 0.0 && options.coverage_threshold <= 1.0))
     throw InputError("transfer: coverage_threshold must lie in (0, 1]");
   const auto start = Clock::now();
-  const SearchOptions search{options.search_margin};
+  SearchOptions search;
+  search.margin = options.search_margin;
+  search.front = true;
   if (slave.dim == 2)
     engine_ = std::make_unique<detail::Engine<2>>(slave, master, search);
   else if (slave.dim == 3)
@@ -285,7 +285,8 @@ void VariationalTransfer::update_master(const mesh::Mesh& master) {
 void VariationalTransfer::assemble_matrix(OwnedMat& matrix, std::vector<PetscInt>* rows,
                                           std::vector<PetscInt>* columns,
                                           const std::vector<double>& values) {
-  if (rows) {  // new pattern: create the matrix (PETSc may reorder the index arrays)
+  if (rows) {        // new pattern: create the matrix (PETSc may reorder the index arrays)
+    matrix.reset();  // memory: the old matrix is not needed while the new one is set up
     OwnedMat created;
     COAPT_PETSC_CHECK(MatCreate(slave_->comm, created.out()));
     COAPT_PETSC_CHECK(MatSetSizes(created, slave_->n_owned_vertices, master_->n_owned_vertices,

@@ -73,10 +73,10 @@ struct TransferStatistics {
   SearchStatistics search;
   std::int64_t intersecting_pairs = 0;  ///< pairs with |S ∩ M| > 0 (this rank)
   std::int64_t local_entries = 0;       ///< (slave vertex, master vertex) entries summed here
-  double search_seconds = 0;            ///< stages 1–2 (exchange, grid, queries)
-  double intersection_seconds = 0;      ///< local_integrals calls
-  double assembly_seconds = 0;          ///< pattern, sums, PETSc assembly, vectors, constrained set
-  bool pattern_reused = false;          ///< B (and B^std) re-filled without re-creation
+  double search_seconds = 0;            ///< exchange, grid and face neighbours (not the front)
+  double intersection_seconds = 0;  ///< the front fused with local_integrals (PairSearch::sweep)
+  double assembly_seconds = 0;      ///< pattern, sums, PETSc assembly, vectors, constrained set
+  bool pattern_reused = false;      ///< B (and B^std) re-filled without re-creation
 };
 
 namespace detail {

@@ -53,6 +53,67 @@ bool separated_by_faces_of(const Simplex<dim>& l, const Simplex<dim>& s) {
 
 }  // namespace
 
+std::vector<int> face_neighbors(int dim, std::span<const int> cells, int n_vertices) {
+  const int k = dim + 1;
+  const std::size_t n_faces = cells.size();  // one per (cell, opposite vertex)
+  std::vector<int> across(n_faces, -1);
+  // Faces as sorted vertex tuples, bucketed by their smallest vertex (counting sort): the
+  // cell across a face is the other cell with the same tuple, in the same bucket.
+  struct Face {
+    std::array<int, 2> rest{};  // the other vertices, ascending (dim = 2: rest[1] = -1)
+    int id = 0;                 // c·k + i
+  };
+  std::vector<int> offsets(static_cast<std::size_t>(n_vertices) + 1, 0);
+  std::vector<Face> faces(n_faces);
+  auto face_of = [&](std::size_t id, int& lowest) {
+    const std::size_t c = id / k;
+    const int i = static_cast<int>(id % k);
+    std::array<int, 3> v{-1, -1, -1};
+    int n = 0;
+    for (int a = 0; a < k; ++a)
+      if (a != i) v[n++] = cells[c * k + a];
+    // ascending, by hand (n ≤ 3)
+    if (v[1] < v[0]) std::swap(v[0], v[1]);
+    if (n == 3) {
+      if (v[2] < v[1]) std::swap(v[1], v[2]);
+      if (v[1] < v[0]) std::swap(v[0], v[1]);
+    }
+    lowest = v[0];
+    return Face{{v[1], n == 3 ? v[2] : -1}, static_cast<int>(id)};
+  };
+  for (std::size_t id = 0; id < n_faces; ++id) {
+    int lowest = 0;
+    faces[id] = face_of(id, lowest);
+    ++offsets[static_cast<std::size_t>(lowest) + 1];
+  }
+  std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
+  std::vector<Face> sorted(n_faces);
+  {
+    std::vector<int> fill(offsets.begin(), offsets.end() - 1);
+    for (std::size_t id = 0; id < n_faces; ++id) {
+      int lowest = 0;
+      face_of(id, lowest);
+      sorted[static_cast<std::size_t>(fill[static_cast<std::size_t>(lowest)]++)] = faces[id];
+    }
+  }
+  // Within a bucket, sort by the other vertices: equal faces become adjacent (a bucket holds
+  // tens of faces, so this beats comparing all pairs in it).
+  for (int v = 0; v < n_vertices; ++v) {
+    const auto begin = sorted.begin() + offsets[v], end = sorted.begin() + offsets[v + 1];
+    std::sort(begin, end, [](const Face& a, const Face& b) { return a.rest < b.rest; });
+    for (auto a = begin; a != end;) {
+      auto b = a + 1;
+      while (b != end && b->rest == a->rest) ++b;
+      if (b - a == 2) {  // a face shared by exactly two cells
+        across[static_cast<std::size_t>(a->id)] = (a + 1)->id / k;
+        across[static_cast<std::size_t>((a + 1)->id)] = a->id / k;
+      }
+      a = b;
+    }
+  }
+  return across;
+}
+
 template <int dim>
 Box<dim> owned_cells_box(const mesh::Mesh& mesh) {
   Box<dim> box = Box<dim>::empty();
@@ -403,6 +464,12 @@ PairSearch<dim>::PairSearch(const mesh::Mesh& slave, const mesh::Mesh& master,
     throw InputError("transfer search: the slave and master meshes must share a communicator");
   if (!(options_.margin >= 0.0)) throw InputError("transfer search: the margin must be >= 0");
   MPI_Comm_dup(slave.comm, &comm_);
+  if (options_.front)
+    slave_neighbors_ = face_neighbors(
+        dim,
+        std::span<const int>(slave.cells.data(),
+                             static_cast<std::size_t>(slave.n_owned_cells) * (dim + 1)),
+        slave.n_vertices());
   full_search();
 }
 
@@ -429,7 +496,7 @@ void PairSearch<dim>::full_search() {
   statistics_.sent_master_cells = exchange_.n_sent_cells();
   statistics_.received_master_cells = exchange_.received().n_cells();
   build_grid();
-  query_pairs();
+  if (!options_.front) query_pairs();
 }
 
 template <int dim>
@@ -443,6 +510,8 @@ void PairSearch<dim>::build_grid() {
     boxes[c] = Box<dim>::of(master_simplices_[c]).inflated(options_.margin);
   }
   grid_.build(boxes);
+  if (options_.front)
+    master_neighbors_ = face_neighbors(dim, received.cells, received.n_vertices());
   statistics_.grid_seconds = seconds_since(start);
 }
 
@@ -467,25 +536,36 @@ void PairSearch<dim>::query_pairs() {
       ++candidates;
       if (!separated_by_face_plane(s, t)) scratch_.push_back(m);
     });
-    if (scratch_.empty()) continue;
-    if (pair_chunks_[chunk].size() + scratch_.size() >
-        std::max(kChunk, pair_chunks_[chunk].capacity())) {
-      ++chunk;
-      if (chunk == pair_chunks_.size()) pair_chunks_.emplace_back();
-      pair_chunks_[chunk].reserve(std::max(kChunk, scratch_.size()));
-    } else if (pair_chunks_[chunk].capacity() == 0) {
-      pair_chunks_[chunk].reserve(std::max(kChunk, scratch_.size()));
-    }
-    std::vector<int>& target = pair_chunks_[chunk];
-    cell_pairs_[static_cast<std::size_t>(c)] = {static_cast<int>(chunk),
-                                                static_cast<int>(target.size()),
-                                                static_cast<int>(scratch_.size())};
-    target.insert(target.end(), scratch_.begin(), scratch_.end());
+    store_pairs(c, chunk);
     n_pairs += static_cast<std::int64_t>(scratch_.size());
   }
   pair_chunks_.resize(chunk + 1);  // drops chunks a larger previous search needed
   statistics_.candidate_pairs = candidates;
   statistics_.pairs = n_pairs;
+  finish_statistics();
+  statistics_.query_seconds = seconds_since(start);
+}
+
+template <int dim>
+void PairSearch<dim>::store_pairs(int c, std::size_t& chunk) {
+  if (scratch_.empty()) return;
+  // a cell's pairs never straddle two chunks
+  if (pair_chunks_[chunk].size() + scratch_.size() >
+      std::max(kChunk, pair_chunks_[chunk].capacity())) {
+    ++chunk;
+    if (chunk == pair_chunks_.size()) pair_chunks_.emplace_back();
+    pair_chunks_[chunk].reserve(std::max(kChunk, scratch_.size()));
+  } else if (pair_chunks_[chunk].capacity() == 0) {
+    pair_chunks_[chunk].reserve(std::max(kChunk, scratch_.size()));
+  }
+  std::vector<int>& target = pair_chunks_[chunk];
+  cell_pairs_[static_cast<std::size_t>(c)] = {
+      static_cast<int>(chunk), static_cast<int>(target.size()), static_cast<int>(scratch_.size())};
+  target.insert(target.end(), scratch_.begin(), scratch_.end());
+}
+
+template <int dim>
+void PairSearch<dim>::finish_statistics() {
   const ReceivedMaster<dim>& received = exchange_.received();
   std::size_t chunk_bytes = 0;
   for (const auto& c : pair_chunks_) chunk_bytes += c.capacity() * sizeof(int);
@@ -496,8 +576,10 @@ void PairSearch<dim>::query_pairs() {
                                  sizeof(int) +
                              master_simplices_.capacity() * sizeof(Simplex<dim>) +
                              grid_.memory_bytes() + cell_pairs_.capacity() * sizeof(CellPairs) +
-                             chunk_bytes + reference_coordinates_.capacity() * sizeof(double);
-  statistics_.query_seconds = seconds_since(start);
+                             chunk_bytes + reference_coordinates_.capacity() * sizeof(double) +
+                             (slave_neighbors_.capacity() + master_neighbors_.capacity() +
+                              visited_.capacity() + queue_.capacity()) *
+                                 sizeof(int);
 }
 
 template <int dim>
@@ -530,7 +612,7 @@ bool PairSearch<dim>::update_master(const mesh::Mesh& master) {
   const ReceivedMaster<dim>& received = exchange_.received();
   for (int c = 0; c < received.n_cells(); ++c) master_simplices_[c] = received.simplex(c);
   statistics_.grid_seconds = seconds_since(start);  // grid itself kept
-  query_pairs();
+  if (!options_.front) query_pairs();
   return true;
 }
 
