@@ -2,6 +2,7 @@
 and small assertions with readable failures."""
 
 import argparse
+import csv
 import json
 import os
 import shutil
@@ -60,3 +61,18 @@ class Runner:
 def read_json(path):
     with open(path) as f:
         return json.load(f)
+
+
+def run_with_series(runner, case, name, *arguments, ranks=1):
+    """Runs `coapt run case --output work/name arguments...`; expects it to complete and returns
+    (summary.json, series.csv rows as floats), or (None, None) after a failed expectation."""
+    out = runner.work / name
+    result = runner.run("run", case, "--output", out, *arguments, ranks=ranks)
+    summary = read_json(out / "summary.json") if (out / "summary.json").is_file() else {}
+    ok = result.returncode == 0 and summary.get("status") == "completed"
+    runner.expect(ok, f"{name} on {ranks} rank(s) runs", result.stdout[-3000:] + result.stderr)
+    if not ok:
+        return None, None
+    with open(out / "series.csv") as f:
+        rows = [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
+    return summary, rows

@@ -14,23 +14,13 @@ with plain Newmark:
    scheme removes);
  - an `impacts.body` that is no body is an input error naming the key."""
 
-import csv
-
-from cli_common import Runner, parse_arguments, read_json
+from cli_common import Runner, parse_arguments, run_with_series
 
 
 def run(r, name, ranks=1, extra=()):
-    out = r.work / name
-    result = r.run("run", r.source / "cases" / "ball_in_box.yaml", "--output", out,
-                   "--set", "output.vtk=false", "--set", "time.end_time=40", *extra, ranks=ranks)
-    summary = read_json(out / "summary.json") if (out / "summary.json").is_file() else {}
-    ok = result.returncode == 0 and summary.get("status") == "completed"
-    r.expect(ok, f"{name} on {ranks} rank(s) runs", result.stdout[-3000:] + result.stderr)
-    if not ok:
-        return None, None
-    with open(out / "series.csv") as f:
-        rows = [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
-    return summary["benchmark"], rows
+    summary, rows = run_with_series(r, r.source / "cases" / "ball_in_box.yaml", name, "--set", "output.vtk=false",
+                                    "--set", "time.end_time=40", *extra, ranks=ranks)
+    return (summary["benchmark"], rows) if summary else (None, None)
 
 
 def force_oscillation(rows, start, end):

@@ -9,26 +9,15 @@ level 0, with the pressure reversed from the start so that the leaflets close (t
    first 5 steps (the added-mass effect of leaflets barely heavier than the fluid);
  - a valve benchmark naming a solid without contact is an input error naming the key."""
 
-import csv
-
-from cli_common import Runner, parse_arguments, read_json
+from cli_common import Runner, parse_arguments, run_with_series
 
 REVERSED = ["--set", "fluid.outlets[0].waveform.times=[0,0.03,1]",
             "--set", "fluid.outlets[0].waveform.values=[0,-1.5,-1.5]"]
 
 
 def run(r, name, ranks, end_time, extra=()):
-    out = r.work / name
-    result = r.run("run", r.source / "cases" / "valve2d.yaml", "--output", out, "--set", "output.vtk=false",
-                   "--set", f"time.end_time={end_time}", *REVERSED, *extra, ranks=ranks)
-    summary = read_json(out / "summary.json") if (out / "summary.json").is_file() else {}
-    ok = result.returncode == 0 and summary.get("status") == "completed"
-    r.expect(ok, f"{name} on {ranks} rank(s) runs", result.stdout[-3000:] + result.stderr)
-    if not ok:
-        return None, None
-    with open(out / "series.csv") as f:
-        rows = [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
-    return summary, rows
+    return run_with_series(r, r.source / "cases" / "valve2d.yaml", name, "--set", "output.vtk=false",
+                           "--set", f"time.end_time={end_time}", *REVERSED, *extra, ranks=ranks)
 
 
 def main():
