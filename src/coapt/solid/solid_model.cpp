@@ -216,14 +216,17 @@ class SolidModelImpl {
   StepReport solve_static(double factor, run::RunOutput& output, const std::string& label,
                           bool verbose) {
     if (parameters_.mixed) return solve_static_mixed(factor, output, label, verbose);
-    if (parameters_.newton.extrapolate) extrapolate_static(factor);
+    StepReport report;
+    if (parameters_.newton.extrapolate) {
+      extrapolate_static(factor);
+      if (lift_dirichlet(factor, output)) ++report.newton_iterations;
+    }
     set_dirichlet(u_, factor);
     fem::update_ghosts(u_);
     const auto residual_norm = [&] {
       ScopedTimer timer(output.timers(), "assemble");
       return assemble_residual(u_.get(), factor, nullptr);
     };
-    StepReport report;
     if (hook_) hook_->begin_step(u_.get());
     const double norm = residual_norm();
     if (!std::isfinite(norm))
@@ -249,9 +252,77 @@ class SolidModelImpl {
     auto difference = fem::create_vertex_vector(mesh_, dim_);
     COAPT_PETSC_CHECK(VecWAXPY(difference, -1.0, previous_static_, u_));
     COAPT_PETSC_CHECK(VecCopy(u_, previous_static_));
-    if (span > 0.0)
-      COAPT_PETSC_CHECK(VecAXPY(u_, (factor - static_factors_[1]) / span, difference));
+    const double ratio = span > 0.0 ? (factor - static_factors_[1]) / span : 0.0;
+    if (ratio != 0.0) COAPT_PETSC_CHECK(VecAXPY(u_, ratio, difference));
+    // The Dirichlet dofs extrapolated the same way (u_ holds the full values before the
+    // first step, so they are computed from the ramps, not taken from u_).
+    {
+      WriteArray data(u_);
+      for (std::size_t k = 0; k < dirichlet_dofs_.size(); ++k) {
+        const auto& condition = *dirichlet_conditions_[k];
+        const double last = condition.ramp_fraction(static_factors_[1]);
+        data[dirichlet_dofs_[k] - mesh_.vertex_offset * dim_] =
+            dirichlet_values_[k] *
+            (last + ratio * (last - condition.ramp_fraction(static_factors_[0])));
+      }
+    }
     static_factors_ = {static_factors_[1], factor};
+  }
+
+  /// newton.predictor: extrapolate, second part. Where the prescribed values at `factor`
+  /// differ from u_ (a new phase of the loading, which the extrapolation cannot know), one
+  /// linearised step K Δu = −R(u) with Δu = ΔD on the Dirichlet dofs (through the hook's
+  /// system) carries the difference ΔD into the body, instead of moving the boundary nodes
+  /// alone (which shears the layer of cells under them and can invert it). The step is kept
+  /// only if no cell inverts. Returns whether it was taken. Collective.
+  bool lift_dirichlet(double factor, run::RunOutput& output) {
+    auto increment = fem::create_vertex_vector(mesh_, dim_);
+    COAPT_PETSC_CHECK(VecSet(increment, 0.0));
+    double jump = 0.0, scale = 0.0;
+    {
+      ReadArray u(u_);
+      WriteArray d(increment);
+      for (std::size_t k = 0; k < dirichlet_dofs_.size(); ++k) {
+        const PetscInt local = dirichlet_dofs_[k] - mesh_.vertex_offset * dim_;
+        d[local] =
+            dirichlet_conditions_[k]->ramp_fraction(factor) * dirichlet_values_[k] - u[local];
+        jump = std::max(jump, std::abs(d[local]));
+        scale = std::max(scale, std::abs(dirichlet_values_[k]));
+      }
+    }
+    double extremes[2] = {jump, scale};
+    MPI_Allreduce(MPI_IN_PLACE, extremes, 2, MPI_DOUBLE, MPI_MAX, comm_);
+    if (extremes[0] <= 1e-10 * extremes[1]) return false;  // the extrapolation already has it
+    fem::update_ghosts(u_);
+    if (hook_) hook_->begin_step(u_.get());
+    {
+      ScopedTimer timer(output.timers(), "assemble");
+      if (!std::isfinite(assemble_residual(u_.get(), factor, nullptr))) return false;
+      assemble_tangent(u_.get(), 0.0);
+    }
+    auto rhs = fem::create_vertex_vector(mesh_, dim_);
+    auto update = fem::create_vertex_vector(mesh_, dim_);
+    COAPT_PETSC_CHECK(VecCopy(residual_, rhs));
+    COAPT_PETSC_CHECK(VecScale(rhs, -1.0));
+    fem::apply_dirichlet(matrix_.mat(), rhs, dirichlet_dofs_, increment);
+    Mat system = hook_ ? hook_->linear_system(u_.get(), matrix_.mat(), rhs) : matrix_.mat();
+    {
+      ScopedTimer timer(output.timers(), "solve");
+      solver_.set_operator(system);
+      COAPT_PETSC_CHECK(VecSet(update, 0.0));
+      solver_.solve(rhs, update);
+    }
+    COAPT_PETSC_CHECK(VecAXPY(u_, 1.0, update));
+    set_dirichlet(u_, factor);
+    fem::update_ghosts(u_);
+    double norm = 0.0;
+    {
+      ScopedTimer timer(output.timers(), "assemble");
+      norm = assemble_residual(u_.get(), factor, nullptr);
+    }
+    if (std::isfinite(norm)) return true;
+    COAPT_PETSC_CHECK(VecAXPY(u_, -1.0, update));  // set_dirichlet follows in solve_static
+    return false;
   }
 
   // --- dynamics -------------------------------------------------------------------------------

@@ -116,7 +116,9 @@ struct NewtonParameters {
   /// `predictor: extrapolate`: a static load step starts from the linear extrapolation of the
   /// last two converged steps, uₙ + (s − sₙ)/(sₙ − sₙ₋₁) (uₙ − uₙ₋₁) (u₀ = 0 at s₀ = 0), not
   /// from uₙ: a prescribed sliding becomes a near-exact first iterate instead of a sheared
-  /// boundary layer that Newton has to damp.
+  /// boundary layer that Newton has to damp. Where the prescribed values still differ from the
+  /// extrapolation (a new loading phase), one linearised step carries the difference into the
+  /// body first (counted as a Newton iteration).
   bool extrapolate = false;
 };
 
