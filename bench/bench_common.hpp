@@ -47,4 +47,15 @@ struct SolidBenchOptions {
 /// Collective.
 io::Json solid(const Context& context, const SolidBenchOptions& options);
 
+struct ContactBenchOptions {
+  std::string case_file = COAPT_SOURCE_DIR "/cases/contact/plates3d.yaml";
+  int level = 1;
+  double size = 0;  ///< mesh.size [m]; 0: the case's
+  int steps = 0;    ///< the first this many of the case's load steps (0: all)
+};
+/// `coapt-bench contact`: the quasi-static press-and-slide of two plates with frictionless
+/// mortar contact: time per load step, Newton iterations and active-set changes
+/// (bench_contact.cpp). Collective.
+io::Json contact(const Context& context, const ContactBenchOptions& options);
+
 }  // namespace coapt::bench

@@ -3,6 +3,7 @@
 //   mpirun -np 2 coapt-bench assembly --n 64
 //   mpirun -np 2 coapt-bench fluid --n 12 -- -fluid_pc_type lu
 //   mpirun -np 2 coapt-bench solid --n 44
+//   mpirun -np 2 coapt-bench contact --level 1 --size 4.5e-4
 //
 // Each sub-command prints what it does and ends with one line holding a JSON object of the
 // figures (rates carry their unit in the key) and the peak memory per rank (peak_rss_mb).
@@ -53,6 +54,18 @@ int main(int argc, char** argv) {
   solid_command->add_option("--n", solid.n, "cells per direction")->check(CLI::Range(1, 200));
   solid_command->add_option("--formulation", solid.formulation, "displacement or mixed")
       ->check(CLI::IsMember({"displacement", "mixed"}));
+  coapt::bench::ContactBenchOptions contact;
+  auto* contact_command = app.add_subcommand(
+      "contact",
+      "two plates pressed and slid with frictionless mortar contact (cases/contact/"
+      "plates3d.yaml): time per load step, Newton iterations, active-set changes");
+  contact_command->add_option("--case", contact.case_file, "the plates case file");
+  contact_command->add_option("--level", contact.level, "mesh.level")->check(CLI::Range(0, 6));
+  contact_command->add_option("--size", contact.size, "mesh.size [m] (0: the case's)")
+      ->check(CLI::Range(0.0, 1.0));
+  contact_command
+      ->add_option("--steps", contact.steps, "run only the first this many load steps (0: all)")
+      ->check(CLI::Range(0, 100000));
   try {
     app.parse(n_ours, argv);
   } catch (const CLI::ParseError& e) {
@@ -66,6 +79,7 @@ int main(int argc, char** argv) {
     if (*transfer_command) figures = coapt::bench::transfer(context, transfer);
     if (*fluid_command) figures = coapt::bench::fluid(context, fluid);
     if (*solid_command) figures = coapt::bench::solid(context, solid);
+    if (*contact_command) figures = coapt::bench::contact(context, contact);
     figures["peak_rss_mb"] = coapt::bench::peak_rss_mb(context.comm());
     if (context.rank() == 0) std::cout << figures.dump(-1) << std::endl;
   } catch (const coapt::Error& e) {

@@ -157,6 +157,9 @@ void ContactConstraints::update(Vec u, Vec residual) {
             first_active ? pressure : std::min(status.min_active_pressure, pressure);
         first_active = false;
         status.total_force += row_sum[j] * pressure;
+        for (int i = 0; i < dim_; ++i)
+          status.force_vector[static_cast<std::size_t>(i)] +=
+              row_sum[j] * pressure * m.normals[static_cast<std::size_t>(j) * dim_ + i];
         status.contact_measure += row_sum[j];
       } else {
         status.max_open_pressure = std::max(status.max_open_pressure, std::abs(pressure));

@@ -36,6 +36,7 @@
 #include <petscmat.h>
 #include <petscvec.h>
 
+#include <array>
 #include <memory>
 #include <span>
 #include <string>
@@ -61,6 +62,10 @@ struct ContactStatus {
   double max_complementarity = 0.0;  ///< max |p_j g_j| over constrained nodes [Pa m]
   double total_force = 0.0;          ///< Σ_j p_j ∫_Γc Φ̃_j over active nodes [N, N/m in 2D]
   double contact_measure = 0.0;      ///< Σ_j ∫_Γc Φ̃_j over active nodes [m², m in 2D]
+  /// Σ_j p_j n_j ∫_Γc Φ̃_j over active nodes: the force the slave surfaces exert on the masters
+  /// [N, N/m in 2D] (dim entries used; with frictionless contact its magnitude is total_force
+  /// when all normals are parallel).
+  std::array<double, 3> force_vector{};
   double complementarity_constant = 0.0;  ///< c in use [Pa/m] (0: not yet known)
   double gap_tolerance = 0.0;             ///< [m]
 };

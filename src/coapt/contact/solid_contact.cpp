@@ -197,6 +197,7 @@ void ContactHook::begin_step(Vec u) {
   (void)u;
   constraints_.begin_step();
   changing_iterations_ = 0;
+  changed_nodes_ = 0;
 }
 
 void ContactHook::add_residual(Vec u, Vec residual) {
@@ -213,6 +214,7 @@ bool ContactHook::accept(Vec u) {
   const auto& status = constraints_.status();
   if (status.changes == 0) return true;
   ++changing_iterations_;
+  changed_nodes_ += status.changes;
   log::debug("contact: {} node(s) changed the active set ({} active)", status.changes,
              status.active);
   if (changing_iterations_ > parameters_.max_active_set_changes)
@@ -243,6 +245,14 @@ void ContactHook::add_series(run::RunOutput& output, const std::string& suffix) 
   series.add("contact_max_pressure" + suffix, s.max_pressure);
   series.add("contact_total_force" + suffix, s.total_force);
   series.add("contact_max_penetration" + suffix, s.max_penetration);
+  series.add("contact_min_active_pressure" + suffix, s.min_active_pressure);
+  series.add("contact_max_open_pressure" + suffix, s.max_open_pressure);
+  series.add("contact_max_complementarity" + suffix, s.max_complementarity);
+  series.add("contact_active_set_changes" + suffix, changing_iterations_);
+  const int dim = constraints_.pairs().empty() ? 0 : constraints_.pairs().front().slave.dim;
+  for (int i = 0; i < dim; ++i)
+    series.add(fmt::format("contact_force_{}{}", "xyz"[i], suffix),
+               s.force_vector[static_cast<std::size_t>(i)]);
 }
 
 void ContactHook::write_nodes(const std::filesystem::path& file, MPI_Comm comm) const {

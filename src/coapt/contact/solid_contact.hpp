@@ -96,6 +96,11 @@ class ContactHook final : public solid::NewtonHook {
   void project_predictor(Vec u, Vec increment) override;
 
   const ContactConstraints& constraints() const { return constraints_; }
+  /// Newton iterations of the current step after which the active set changed (the step
+  /// cannot end at those).
+  int active_set_change_iterations() const { return changing_iterations_; }
+  /// Nodes that entered or left the active set, summed over those iterations of the step.
+  int active_set_node_changes() const { return changed_nodes_; }
   /// The contact fields for SolidModel::write_vtk (pressure, gap, active set).
   std::vector<io::Field> fields();
   /// Adds the contact columns of the current state to the series row being built, each name
@@ -111,6 +116,7 @@ class ContactHook final : public solid::NewtonHook {
   ContactParameters parameters_;
   ContactConstraints constraints_;
   int changing_iterations_ = 0;
+  int changed_nodes_ = 0;
   std::vector<double> pressure_, gap_, active_;
 };
 

@@ -221,13 +221,17 @@ class SolidModelImpl {
   StepReport solve_static(double factor, run::RunOutput& output, const std::string& label,
                           bool verbose) {
     if (parameters_.mixed) return solve_static_mixed(factor, output, label, verbose);
+    StepReport report;
+    if (parameters_.newton.extrapolate) {
+      extrapolate_static(factor);
+      if (lift_dirichlet(factor, output)) ++report.newton_iterations;
+    }
     set_dirichlet(u_, factor);
     fem::update_ghosts(u_);
     const auto residual_norm = [&] {
       ScopedTimer timer(output.timers(), "assemble");
       return assemble_residual(u_.get(), factor, nullptr);
     };
-    StepReport report;
     if (hook_) hook_->begin_step(u_.get());
     const double norm = residual_norm();
     if (!std::isfinite(norm))
@@ -239,6 +243,91 @@ class SolidModelImpl {
         output, report, [&] { assemble_tangent(u_.get(), 0.0); }, residual_norm, label,
         "use more load steps", verbose);
     return report;
+  }
+
+  /// newton.predictor: extrapolate. u_ holds uₙ (load factor sₙ) on entry and
+  /// uₙ + (s − sₙ)/(sₙ − sₙ₋₁) (uₙ − uₙ₋₁) on return (uₙ₋₁ = 0 at sₙ₋₁ = 0 before the first
+  /// step, so the first step starts from uₙ = 0); the step is assumed to converge at s.
+  void extrapolate_static(double factor) {
+    if (!previous_static_) {
+      previous_static_ = fem::create_vertex_vector(mesh_, dim_);
+      COAPT_PETSC_CHECK(VecSet(previous_static_, 0.0));
+    }
+    const double span = static_factors_[1] - static_factors_[0];
+    auto difference = fem::create_vertex_vector(mesh_, dim_);
+    COAPT_PETSC_CHECK(VecWAXPY(difference, -1.0, previous_static_, u_));
+    COAPT_PETSC_CHECK(VecCopy(u_, previous_static_));
+    const double ratio = span > 0.0 ? (factor - static_factors_[1]) / span : 0.0;
+    if (ratio != 0.0) COAPT_PETSC_CHECK(VecAXPY(u_, ratio, difference));
+    // The Dirichlet dofs extrapolated the same way (u_ holds the full values before the
+    // first step, so they are computed from the ramps, not taken from u_).
+    {
+      WriteArray data(u_);
+      for (std::size_t k = 0; k < dirichlet_dofs_.size(); ++k) {
+        const auto& condition = *dirichlet_conditions_[k];
+        const double last = condition.ramp_fraction(static_factors_[1]);
+        data[dirichlet_dofs_[k] - mesh_.vertex_offset * dim_] =
+            dirichlet_values_[k] *
+            (last + ratio * (last - condition.ramp_fraction(static_factors_[0])));
+      }
+    }
+    static_factors_ = {static_factors_[1], factor};
+  }
+
+  /// newton.predictor: extrapolate, second part. Where the prescribed values at `factor`
+  /// differ from u_ (a new phase of the loading, which the extrapolation cannot know), one
+  /// linearised step K Δu = −R(u) with Δu = ΔD on the Dirichlet dofs (through the hook's
+  /// system) carries the difference ΔD into the body, instead of moving the boundary nodes
+  /// alone (which shears the layer of cells under them and can invert it). The step is kept
+  /// only if no cell inverts. Returns whether it was taken. Collective.
+  bool lift_dirichlet(double factor, run::RunOutput& output) {
+    auto increment = fem::create_vertex_vector(mesh_, dim_);
+    COAPT_PETSC_CHECK(VecSet(increment, 0.0));
+    double jump = 0.0, scale = 0.0;
+    {
+      ReadArray u(u_);
+      WriteArray d(increment);
+      for (std::size_t k = 0; k < dirichlet_dofs_.size(); ++k) {
+        const PetscInt local = dirichlet_dofs_[k] - mesh_.vertex_offset * dim_;
+        d[local] =
+            dirichlet_conditions_[k]->ramp_fraction(factor) * dirichlet_values_[k] - u[local];
+        jump = std::max(jump, std::abs(d[local]));
+        scale = std::max(scale, std::abs(dirichlet_values_[k]));
+      }
+    }
+    double extremes[2] = {jump, scale};
+    MPI_Allreduce(MPI_IN_PLACE, extremes, 2, MPI_DOUBLE, MPI_MAX, comm_);
+    if (extremes[0] <= 1e-10 * extremes[1]) return false;  // the extrapolation already has it
+    fem::update_ghosts(u_);
+    if (hook_) hook_->begin_step(u_.get());
+    {
+      ScopedTimer timer(output.timers(), "assemble");
+      if (!std::isfinite(assemble_residual(u_.get(), factor, nullptr))) return false;
+      assemble_tangent(u_.get(), 0.0);
+    }
+    auto rhs = fem::create_vertex_vector(mesh_, dim_);
+    auto update = fem::create_vertex_vector(mesh_, dim_);
+    COAPT_PETSC_CHECK(VecCopy(residual_, rhs));
+    COAPT_PETSC_CHECK(VecScale(rhs, -1.0));
+    fem::apply_dirichlet(matrix_.mat(), rhs, dirichlet_dofs_, increment);
+    Mat system = hook_ ? hook_->linear_system(u_.get(), matrix_.mat(), rhs) : matrix_.mat();
+    {
+      ScopedTimer timer(output.timers(), "solve");
+      solver_.set_operator(system);
+      COAPT_PETSC_CHECK(VecSet(update, 0.0));
+      solver_.solve(rhs, update);
+    }
+    COAPT_PETSC_CHECK(VecAXPY(u_, 1.0, update));
+    set_dirichlet(u_, factor);
+    fem::update_ghosts(u_);
+    double norm = 0.0;
+    {
+      ScopedTimer timer(output.timers(), "assemble");
+      norm = assemble_residual(u_.get(), factor, nullptr);
+    }
+    if (std::isfinite(norm)) return true;
+    COAPT_PETSC_CHECK(VecAXPY(u_, -1.0, update));  // set_dirichlet follows in solve_static
+    return false;
   }
 
   // --- dynamics -------------------------------------------------------------------------------
@@ -952,9 +1041,15 @@ class SolidModelImpl {
     return group->tag;
   }
 
-  /// The owned Dirichlet dofs with their final values (a later condition wins on a dof).
+  /// The owned Dirichlet dofs with their final values and conditions (a later condition wins
+  /// on a dof).
   void collect_dirichlet() {
-    std::vector<std::pair<PetscInt, double>> prescribed;
+    struct Prescribed {
+      PetscInt dof;
+      double value;
+      const DirichletParameters* condition;
+    };
+    std::vector<Prescribed> prescribed;
     for (const auto& condition : parameters_.dirichlet) {
       const int tag = facet_tag(condition.boundary, condition.where);
       std::vector<int> components = condition.components;
@@ -964,15 +1059,16 @@ class SolidModelImpl {
         const int component[1] = {components[k]};
         const double value = condition.values.empty() ? 0.0 : condition.values[k];
         for (PetscInt dof : fem::boundary_dofs(mesh_, dim_, tag, component))
-          prescribed.emplace_back(dof, value);
+          prescribed.push_back({dof, value, &condition});
       }
     }
     std::stable_sort(prescribed.begin(), prescribed.end(),
-                     [](const auto& a, const auto& b) { return a.first < b.first; });
+                     [](const auto& a, const auto& b) { return a.dof < b.dof; });
     for (std::size_t i = 0; i < prescribed.size(); ++i) {
-      if (i + 1 < prescribed.size() && prescribed[i + 1].first == prescribed[i].first) continue;
-      dirichlet_dofs_.push_back(prescribed[i].first);
-      dirichlet_values_.push_back(prescribed[i].second);
+      if (i + 1 < prescribed.size() && prescribed[i + 1].dof == prescribed[i].dof) continue;
+      dirichlet_dofs_.push_back(prescribed[i].dof);
+      dirichlet_values_.push_back(prescribed[i].value);
+      dirichlet_conditions_.push_back(prescribed[i].condition);
     }
   }
 
@@ -1012,11 +1108,13 @@ class SolidModelImpl {
     }
   }
 
-  /// Sets the Dirichlet dofs of `vector` to factor × their values. Ghosts not updated.
+  /// Sets the Dirichlet dofs of `vector` to their values at load factor `factor` (each ramped
+  /// over its condition's interval: factor × value without a `ramp`). Ghosts not updated.
   void set_dirichlet(Vec vector, double factor) {
     WriteArray data(vector);
     for (std::size_t k = 0; k < dirichlet_dofs_.size(); ++k)
-      data[dirichlet_dofs_[k] - mesh_.vertex_offset * dim_] = factor * dirichlet_values_[k];
+      data[dirichlet_dofs_[k] - mesh_.vertex_offset * dim_] =
+          dirichlet_conditions_[k]->ramp_fraction(factor) * dirichlet_values_[k];
   }
   void zero_dirichlet(Vec vector) { set_dirichlet(vector, 0.0); }
 
@@ -1425,6 +1523,8 @@ class SolidModelImpl {
   double pressure_scale_ = 1.0;                 ///< S: the mixed state holds p / S [Pa]
   std::vector<PetscInt> dirichlet_dofs_;        ///< owned, sorted
   std::vector<double> dirichlet_values_;        ///< final value of each, [m]
+  /// The condition that prescribes each (its ramp interval); points into parameters_.
+  std::vector<const DirichletParameters*> dirichlet_conditions_;
   std::vector<ProbeLocation> probes_;
 
   OwnedVec u_, v_, a_;                                ///< trial state
@@ -1433,6 +1533,8 @@ class SolidModelImpl {
   OwnedVec residual_, inertia_;
   // contact-stabilized Newmark: the projected predictor increment δ, Rₙ, a work vector
   OwnedVec predictor_, static_residual_, work_;
+  OwnedVec previous_static_;                    ///< uₙ₋₁ of newton.predictor: extrapolate
+  std::array<double, 2> static_factors_{0, 0};  ///< sₙ₋₁, sₙ of the converged static steps
   fem::P1Matrix matrix_;
   std::optional<fem::P1Matrix> mass_;  ///< inertia-density mass (dynamics only)
   fem::LinearSolver solver_;

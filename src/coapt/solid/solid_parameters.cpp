@@ -2,6 +2,7 @@
 #include "coapt/solid/solid_parameters.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <cmath>
 
@@ -142,6 +143,18 @@ SolidParameters SolidParameters::read(const config::Section& root) {
         "displacement", {}, {"m", "final displacement per listed component (empty: zero)"});
     if (!condition.values.empty() && !names.empty() && condition.values.size() != names.size())
       section.fail("displacement", "expected one value per entry of components");
+    const auto ramp = section.get<std::vector<double>>(
+        "ramp", {0.0, 1.0},
+        {"",
+         "load-factor interval [start, end] over which the displacement ramps from 0 to its "
+         "value (0 before, full after; static load steps)"});
+    if (ramp.size() != 2 || !(0.0 <= ramp[0] && ramp[0] < ramp[1] && ramp[1] <= 1.0))
+      section.fail("ramp",
+                   fmt::format("expected [start, end] with 0 <= start < end <= 1 (got [{}])",
+                               fmt::join(ramp, ", ")));
+    condition.ramp_start = ramp[0];
+    condition.ramp_end = ramp[1];
+    condition.ramped = section.has("ramp");
     p.dirichlet.push_back(std::move(condition));
   }
   if (p.dirichlet.empty())
@@ -189,6 +202,12 @@ SolidParameters SolidParameters::read(const config::Section& root) {
       {"", "or when |du| <= dtol |u| (round-off floor of R)", Bounds::closed(0.0, 1e-3)});
   p.newton.max_iterations = newton.get<int>(
       "max_iterations", 25, {"", "iterations per load step", Bounds::closed(1, 1000)});
+  p.newton.extrapolate =
+      newton.choice("predictor", "previous", {"previous", "extrapolate"},
+                    {"",
+                     "initial iterate of a load step: previous (the last solution) or "
+                     "extrapolate (linearly from the last two; static, displacement "
+                     "formulation)"}) == "extrapolate";
 
   auto time = root.section("time", "time integration (static load stepping or Newmark)");
   p.time.where = located(time);
@@ -217,6 +236,13 @@ SolidParameters SolidParameters::read(const config::Section& root) {
                 "loads act in full from t = 0 (remove steps)");
   }
 
+  for (const auto& condition : p.dirichlet)
+    if (condition.ramped && p.time.dynamic)
+      throw InputError(fmt::format(
+          "{}.ramp: a ramp interval is for static load steps; with time.scheme = {} the "
+          "prescribed displacements act in full from t = 0 (remove ramp)",
+          condition.where, scheme));
+
   for (const auto& section : root.sections("probes", "points where the displacement is reported")) {
     ProbeParameters probe;
     probe.where = located(section);
@@ -224,6 +250,12 @@ SolidParameters SolidParameters::read(const config::Section& root) {
     probe.point = section.require<std::vector<double>>("point", {"m", "reference coordinates"});
     p.probes.push_back(std::move(probe));
   }
+
+  p.reaction_boundaries = root.get<std::vector<std::string>>(
+      "reactions", {},
+      {"", "boundary groups whose reaction force goes to series.csv and summary.json (static)"});
+  if (!p.reaction_boundaries.empty() && p.time.dynamic)
+    root.fail("reactions", "reaction forces are reported for the static scheme only");
 
   if (root.has("uniaxial_reference")) {
     auto section = root.section("uniaxial_reference",
@@ -277,6 +309,9 @@ SolidParameters SolidParameters::read(const config::Section& root) {
                         {"",
                          "displacement, or mixed: P1-P1 displacement-pressure against locking "
                          "(nearly incompressible laws, static)"}) == "mixed";
+  if (p.newton.extrapolate && (p.mixed || p.time.dynamic))
+    newton.fail("predictor",
+                "extrapolate is for static load steps of the displacement formulation");
   if (p.mixed) {
     if (p.time.dynamic)
       root.fail("formulation", "the mixed formulation is static only (time.scheme: static)");

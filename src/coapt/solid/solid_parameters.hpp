@@ -13,6 +13,8 @@
 ///   dirichlet:
 ///     - {boundary: left}                              all components fixed
 ///     - {boundary: top, components: [y], displacement: [0.001]}   ramped with the load
+///     - {boundary: top, components: [x], displacement: [0.002], ramp: [0.5, 1]}
+///                                      ramped over that part of the load factor only
 ///   tractions:                         dead loads on the reference boundary, ramped
 ///     - {boundary: right, traction: [0, 62500]}       Pa (force per reference area/length)
 ///     - {boundary: right, total_force: [0, 1]}        N (3D) or N/m (2D): spread uniformly
@@ -27,8 +29,10 @@
 ///                                      bodies[].initial_velocity overrides it per body
 ///   impacts: {body: ball}              dynamics with contact: rebound angles and energy loss
 ///                                      of each impact of that body (solid_problem.cpp)
-///   newton: {relative_tolerance, absolute_tolerance, update_tolerance, max_iterations}
+///   newton: {relative_tolerance, absolute_tolerance, update_tolerance, max_iterations,
+///            predictor: previous | extrapolate}
 ///   probes: [{name: tip, point: [0.048, 0.060]}]
+///   reactions: [base, top]             boundary groups whose reaction force is reported
 ///   uniaxial_reference: {axis: [1, 0, 0], reaction_boundary: right, reference_area: 1e-6}
 ///   lame_reference: {inner_radius: 0.01, outer_radius: 0.02, inner_probe: a, outer_probe: b}
 ///   output: {vtk: true, vtk_interval: 10, checkpoint_interval: 100}
@@ -63,7 +67,20 @@ struct DirichletParameters {
   std::string boundary;
   std::vector<int> components;  ///< 0 = x, 1 = y, 2 = z
   std::vector<double> values;   ///< final displacement per component [m]
+  /// The load-factor interval [ramp_start, ramp_end] ⊆ [0, 1] over which the values ramp
+  /// linearly from 0 (zero before it, the full values after it): press, then slide.
+  double ramp_start = 0.0, ramp_end = 1.0;
+  bool ramped = false;  ///< the case gave `ramp`
   std::string where;
+
+  /// The fraction of the final values prescribed at load factor s ∈ [0, 1] (s itself
+  /// without a `ramp`).
+  double ramp_fraction(double s) const {
+    if (!ramped) return s;
+    if (s <= ramp_start) return 0.0;
+    if (s >= ramp_end) return 1.0;
+    return (s - ramp_start) / (ramp_end - ramp_start);
+  }
 };
 
 /// A dead load on a boundary group, in the reference configuration (ramped with the load).
@@ -96,6 +113,13 @@ struct NewtonParameters {
   double absolute_tolerance = 0;
   double update_tolerance = 1e-12;
   int max_iterations = 25;
+  /// `predictor: extrapolate`: a static load step starts from the linear extrapolation of the
+  /// last two converged steps, uₙ + (s − sₙ)/(sₙ − sₙ₋₁) (uₙ − uₙ₋₁) (u₀ = 0 at s₀ = 0), not
+  /// from uₙ: a prescribed sliding becomes a near-exact first iterate instead of a sheared
+  /// boundary layer that Newton has to damp. Where the prescribed values still differ from the
+  /// extrapolation (a new loading phase), one linearised step carries the difference into the
+  /// body first (counted as a Newton iteration).
+  bool extrapolate = false;
 };
 
 /// Time integration: `static` (load stepping, the default), `newmark` (β = 1/4, γ = 1/2) or
@@ -147,6 +171,9 @@ struct SolidParameters {
   NewtonParameters newton;
   TimeParameters time;
   std::vector<ProbeParameters> probes;
+  /// Boundary groups whose reaction force (Σ f_int over their vertices) is written per load
+  /// step to series.csv and at the end to summary.json (static scheme only).
+  std::vector<std::string> reaction_boundaries;
   UniaxialReference uniaxial;
   /// `formulation: mixed`: P1–P1 displacement–pressure with pressure stabilisation
   /// (mixed_elements.hpp) instead of the displacement formulation; static only.

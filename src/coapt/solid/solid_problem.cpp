@@ -4,11 +4,15 @@
 #include "coapt/solid/solid_problem.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <petscsys.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "coapt/contact/solid_contact.hpp"
@@ -51,6 +55,9 @@ class SolidProblem final : public run::Problem {
       log::warn(
           "time.scheme contact_stabilized_newmark without a contact section: Newmark with a "
           "lumped mass");
+    // An unknown reaction boundary is an input error now, not after the first load step.
+    for (const auto& boundary : parameters().reaction_boundaries)
+      (void)solid_.reaction_force(boundary);
     if (!impact_body_name_.empty()) {
       const auto section = root.section("impacts", "impacts of a body against the others");
       if (!parameters().time.dynamic || !contact_)
@@ -97,6 +104,37 @@ class SolidProblem final : public run::Problem {
     return parameters().probes[p].name + "_displacement_" + kComponentNames[i];
   }
 
+  /// "reaction_base_y" for a boundary, component i.
+  std::string reaction_key(const std::string& boundary, int i) const {
+    return "reaction_" + boundary + "_" + kComponentNames[i];
+  }
+
+  /// Per-step figures of a static run and the contact extremes over all its load steps.
+  struct StepHistory {
+    std::vector<int> newton_iterations, active_nodes, active_set_changes;
+    double max_penetration = 0, max_complementarity = 0, max_open_pressure = 0;
+    double min_active_pressure = std::numeric_limits<double>::infinity();
+
+    void add(const contact::ContactStatus& status, int changes) {
+      active_nodes.push_back(status.active);
+      active_set_changes.push_back(changes);
+      max_penetration = std::max(max_penetration, status.max_penetration);
+      max_complementarity = std::max(max_complementarity, status.max_complementarity);
+      max_open_pressure = std::max(max_open_pressure, status.max_open_pressure);
+      if (status.active > 0)
+        min_active_pressure = std::min(min_active_pressure, status.min_active_pressure);
+    }
+    void write(io::Json& benchmark) const {
+      benchmark["contact_active_nodes_per_step"] = io::Json::array_of(active_nodes);
+      benchmark["contact_active_set_changes_per_step"] = io::Json::array_of(active_set_changes);
+      benchmark["contact_max_penetration_over_steps"] = max_penetration;
+      benchmark["contact_max_complementarity_over_steps"] = max_complementarity;
+      benchmark["contact_max_open_pressure_over_steps"] = max_open_pressure;
+      benchmark["contact_min_active_pressure_over_steps"] =
+          std::isfinite(min_active_pressure) ? min_active_pressure : 0.0;
+    }
+  };
+
   void write_mesh_figures(io::Json& benchmark) const {
     benchmark["cells"] = static_cast<std::int64_t>(solid_.mesh().n_global_cells);
     benchmark["vertices"] = static_cast<std::int64_t>(solid_.mesh().n_global_vertices);
@@ -106,6 +144,7 @@ class SolidProblem final : public run::Problem {
   void solve_static(run::RunOutput& output) {
     const int steps = parameters().steps;
     int total_newton = 0, total_linear = 0;
+    StepHistory history;
     for (int step = 1; step <= steps; ++step) {
       const double factor = static_cast<double>(step) / steps;
       const auto report = solid_.solve_static(
@@ -120,9 +159,16 @@ class SolidProblem final : public run::Problem {
       series.add("residual_norm", report.norm());
       for (std::size_t p = 0; p < values.size(); ++p)
         for (int i = 0; i < dim(); ++i) series.add(probe_key(p, i), values[p][i]);
+      for (const auto& boundary : parameters().reaction_boundaries) {
+        const auto reaction = solid_.reaction_force(boundary);
+        for (int i = 0; i < dim(); ++i)
+          series.add(reaction_key(boundary, i), reaction[static_cast<std::size_t>(i)]);
+      }
+      history.newton_iterations.push_back(report.newton_iterations);
       if (contact_) {
         contact_->add_series(output);
         contact_->log_status(fmt::format("load step {}/{}", step, steps));
+        history.add(contact_->constraints().status(), contact_->active_set_change_iterations());
       }
       series.end_row();
       if (parameters().write_vtk) write_vtk(output, factor);
@@ -137,8 +183,16 @@ class SolidProblem final : public run::Problem {
       }
     write_mesh_figures(benchmark);
     write_closed_form_benchmark(solid_, benchmark);
+    for (const auto& boundary : parameters().reaction_boundaries) {
+      const auto reaction = solid_.reaction_force(boundary);
+      for (int i = 0; i < dim(); ++i)
+        benchmark[reaction_key(boundary, i)] = reaction[static_cast<std::size_t>(i)];
+      log::info("reaction on '{}': ({:.8e}) N", boundary, fmt::join(reaction, ", "));
+    }
+    benchmark["newton_iterations_per_step"] = io::Json::array_of(history.newton_iterations);
     if (contact_) {
       write_contact_figures(benchmark);
+      history.write(benchmark);
       contact_->write_nodes(output.directory() / "contact_nodes.csv", solid_.comm());
     }
     auto& iterations = output.summary()["iterations"];
@@ -159,6 +213,9 @@ class SolidProblem final : public run::Problem {
     const auto& status = contact_->constraints().status();
     benchmark["contact_active_nodes"] = status.active;
     benchmark["contact_total_force"] = status.total_force;
+    for (int i = 0; i < dim(); ++i)
+      benchmark[fmt::format("contact_force_{}", kComponentNames[i])] =
+          status.force_vector[static_cast<std::size_t>(i)];
     benchmark["contact_min_active_pressure"] = status.min_active_pressure;
     benchmark["contact_max_penetration"] = status.max_penetration;
     benchmark["contact_max_complementarity"] = status.max_complementarity;
