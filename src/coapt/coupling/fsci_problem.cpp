@@ -274,6 +274,8 @@ struct CouplingReport {
   std::vector<double> history;     ///< ‖f^l − f_applied^l‖ per iteration
   std::vector<double> relaxation;  ///< ω per iteration
   fluid::NewtonReport fluid;       ///< the last fluid solve
+  int newton_iterations = 0;       ///< fluid Newton iterations over the coupling iterations
+  int linear_iterations = 0;       ///< and their Krylov iterations
 };
 
 class FsciProblem final : public run::Problem {
@@ -408,8 +410,8 @@ class FsciProblem final : public run::Problem {
             fmt::format("fsci: the steady coupling did not converge in {} iterations; |df| "
                         "history {:.3e}",
                         report.coupling.iterations, fmt::join(report.coupling.history, ", ")));
-      newton_total = report.coupling.fluid.iterations;
-      linear_total = report.coupling.fluid.linear_iterations;
+      newton_total = report.coupling.newton_iterations;
+      linear_total = report.coupling.linear_iterations;
       coupling_total = report.coupling.iterations;
       record_step(output, 0.0, report.coupling);
     } else {
@@ -429,8 +431,8 @@ class FsciProblem final : public run::Problem {
         }
         ++step;
         n_steps_done = step;
-        newton_total += report.fluid.iterations;
-        linear_total += report.fluid.linear_iterations;
+        newton_total += report.newton_iterations;
+        linear_total += report.linear_iterations;
         coupling_total += report.iterations;
         record_step(output, fluid_.time(), report);
         if (p.write_vtk && p.vtk_interval > 0 && step % p.vtk_interval == 0) {
@@ -440,7 +442,7 @@ class FsciProblem final : public run::Problem {
         }
         progress.step(
             std::min(step, p.time.n_steps()), fluid_.time(),
-            fmt::format("coupling {}, newton {}", report.iterations, report.fluid.iterations));
+            fmt::format("coupling {}, newton {}", report.iterations, report.newton_iterations));
       }
     }
     fluid_.write_windkessel_states(output);
@@ -592,6 +594,8 @@ class FsciProblem final : public run::Problem {
                    : fluid_.solve(fmt::format("fluid to t = {:g} s, coupling "
                                               "iteration {}",
                                               time, iteration));
+        report.newton_iterations += report.fluid.iterations;
+        report.linear_iterations += report.fluid.linear_iterations;
       }
       ScopedTimer timer(output.timers(), "coupling");
       compute_forces();  // (4)
