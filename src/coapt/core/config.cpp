@@ -109,6 +109,10 @@ std::string Section::where(std::string_view key) const {
   return document_->where(node_, path_);
 }
 
+std::string Section::located(std::string_view key) const {
+  return fmt::format("{}: {}", where(key), key.empty() ? path_ : child_path(key));
+}
+
 void Section::fail(std::string_view key, const std::string& message) const {
   const std::string path = key.empty() ? path_ : child_path(key);
   throw InputError(fmt::format("{}: {}: {}", where(key), path.empty() ? "(case)" : path, message));

@@ -81,6 +81,8 @@ class Section {
   const std::string& path() const { return path_; }
   /// Location "file:line" of `key` (or of this section when key is empty).
   std::string where(std::string_view key = "") const;
+  /// "file:line: path" of `key` (or of this section): the prefix of a message about it.
+  std::string located(std::string_view key = "") const;
   /// Folder of the case file: relative paths in the case are relative to it.
   std::string case_directory() const;
 

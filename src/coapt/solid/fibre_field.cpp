@@ -20,14 +20,6 @@ using config::Bounds;
 
 namespace {
 
-std::string located(const config::Section& section, std::string_view key = "") {
-  const std::string path =
-      key.empty()
-          ? section.path()
-          : (section.path().empty() ? std::string(key) : section.path() + "." + std::string(key));
-  return fmt::format("{}: {}", section.where(key), path);
-}
-
 /// A 2- or 3-component vector key (a 2D vector gets z = 0).
 Vector3 read_vector(const config::Section& section, std::string_view key, std::string_view unit,
                     std::string_view doc) {
@@ -92,7 +84,7 @@ FibreFieldParameters FibreFieldParameters::read(const config::Section& body, int
   if (short_form) {
     if (body.has("fibres"))
       body.fail("fibres", "give either fibres or fibre_direction (the short form), not both");
-    p.where = located(body);
+    p.where = body.located();
     p.rule = Rule::constant;
     p.constant.a0[0] = read_vector(body, "fibre_direction", "", "unit fibre direction (reference)");
     if (families > 1)
@@ -101,7 +93,7 @@ FibreFieldParameters FibreFieldParameters::read(const config::Section& body, int
     return p;
   }
   const auto section = body.section("fibres", "fibre directions (fibre_reinforced only)");
-  p.where = located(section);
+  p.where = section.located();
   const std::string rule = section.choice(
       "rule", "", {"constant", "circumferential", "file"},
       {"",

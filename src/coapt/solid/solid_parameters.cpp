@@ -14,15 +14,6 @@ using config::Bounds;
 
 namespace {
 
-// "file:line: path" of a key, the prefix of every message about it.
-std::string located(const config::Section& section, std::string_view key = "") {
-  const std::string path =
-      key.empty()
-          ? section.path()
-          : (section.path().empty() ? std::string(key) : section.path() + "." + std::string(key));
-  return fmt::format("{}: {}", section.where(key), path);
-}
-
 int component_index(const config::Section& section, const std::string& name) {
   if (name == "x") return 0;
   if (name == "y") return 1;
@@ -38,7 +29,7 @@ Material read_material(const config::Section& section) {
                      {"linear_elastic", "saint_venant_kirchhoff", "neo_hookean",
                       "nearly_incompressible_neo_hookean", "fibre_reinforced"},
                      {"", "constitutive law"});
-  const std::string where = located(section);
+  const std::string where = section.located();
   // Elastic constants: (young_modulus, poisson_ratio) or (shear_modulus with one of
   // poisson_ratio, lambda, bulk_modulus); the rest follows from the isotropic relations
   // λ = 2μν/(1 − 2ν), κ = λ + 2μ/3.
@@ -109,7 +100,7 @@ SolidParameters SolidParameters::read(const config::Section& root) {
   int catch_all = 0;
   for (const auto& section : bodies) {
     BodyParameters body;
-    body.where = located(section);
+    body.where = section.located();
     body.name = section.get<std::string>("name", "body", {"", "name of the body"});
     body.cell_groups = section.get<std::vector<std::string>>(
         "cell_groups", {}, {"", "mesh cell groups of the body (empty: all remaining cells)"});
@@ -134,7 +125,7 @@ SolidParameters SolidParameters::read(const config::Section& root) {
 
   for (const auto& section : root.sections("dirichlet", "prescribed displacements")) {
     DirichletParameters condition;
-    condition.where = located(section);
+    condition.where = section.located();
     condition.boundary = section.require<std::string>("boundary", {"", "boundary group"});
     const auto names = section.get<std::vector<std::string>>(
         "components", {}, {"", "prescribed components x, y, z (empty: all)"});
@@ -164,7 +155,7 @@ SolidParameters SolidParameters::read(const config::Section& root) {
 
   for (const auto& section : root.sections("tractions", "dead loads on boundary groups")) {
     TractionParameters load;
-    load.where = located(section);
+    load.where = section.located();
     load.boundary = section.require<std::string>("boundary", {"", "boundary group"});
     const bool has_traction = section.has("traction"), has_total = section.has("total_force");
     if (has_traction == has_total)
@@ -180,7 +171,7 @@ SolidParameters SolidParameters::read(const config::Section& root) {
   for (const auto& section : root.sections(
            "pressures", "follower pressures on boundary groups (current configuration)")) {
     PressureParameters load;
-    load.where = located(section);
+    load.where = section.located();
     load.boundary = section.require<std::string>("boundary", {"", "boundary group"});
     load.pressure = section.require<double>(
         "pressure", {"Pa", "pressure p: load -p n da on the current boundary (n outward)"});
@@ -188,7 +179,7 @@ SolidParameters SolidParameters::read(const config::Section& root) {
   }
 
   p.gravity = root.get<std::vector<double>>("gravity", {}, {"m/s^2", "gravity (body force ρ g)"});
-  p.gravity_where = located(root, "gravity");
+  p.gravity_where = root.located("gravity");
   p.steps = root.get<int>("steps", 1, {"", "load steps", Bounds::closed(1, 100000)});
 
   auto newton = root.section("newton", "Newton's method per load step");
@@ -210,7 +201,7 @@ SolidParameters SolidParameters::read(const config::Section& root) {
                      "formulation)"}) == "extrapolate";
 
   auto time = root.section("time", "time integration (static load stepping or Newmark)");
-  p.time.where = located(time);
+  p.time.where = time.located();
   const auto scheme = time.choice(
       "scheme", "static", {"static", "newmark", "contact_stabilized_newmark"},
       {"",
@@ -245,7 +236,7 @@ SolidParameters SolidParameters::read(const config::Section& root) {
 
   for (const auto& section : root.sections("probes", "points where the displacement is reported")) {
     ProbeParameters probe;
-    probe.where = located(section);
+    probe.where = section.located();
     probe.name = section.require<std::string>("name", {"", "name in series.csv and summary.json"});
     probe.point = section.require<std::vector<double>>("point", {"m", "reference coordinates"});
     p.probes.push_back(std::move(probe));
@@ -261,7 +252,7 @@ SolidParameters SolidParameters::read(const config::Section& root) {
     auto section = root.section("uniaxial_reference",
                                 "compare a homogeneous uniaxial stretch with its closed form");
     p.uniaxial.enabled = true;
-    p.uniaxial.where = located(section);
+    p.uniaxial.where = section.located();
     const auto axis = section.require<std::vector<double>>("axis", {"", "stretch axis (3D)"});
     if (axis.size() != 3) section.fail("axis", "expected 3 components (a 3D case)");
     p.uniaxial.axis = Vector3(axis[0], axis[1], axis[2]);
@@ -287,7 +278,7 @@ SolidParameters SolidParameters::read(const config::Section& root) {
     auto section = root.section("lame_reference",
                                 "compare an inflated thick-walled cylinder with Lame's solution");
     p.lame.enabled = true;
-    p.lame.where = located(section);
+    p.lame.where = section.located();
     p.lame.inner_radius =
         section.require<double>("inner_radius", {"m", "inner radius a", Bounds::positive()});
     p.lame.outer_radius =

@@ -62,9 +62,7 @@ VectorKey read_vector(const config::Section& section, std::string_view key,
                       const config::KeyInfo& info) {
   VectorKey v;
   v.value = section.get<std::vector<double>>(key, {}, info);
-  const std::string path =
-      section.path().empty() ? std::string(key) : section.path() + "." + std::string(key);
-  v.where = section.where(key) + ": " + path;
+  v.where = section.located(key);
   return v;
 }
 
