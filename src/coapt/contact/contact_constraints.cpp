@@ -107,17 +107,10 @@ void ContactConstraints::update(Vec u, Vec residual) {
   status.complementarity_constant = complementarity_constant_;
   status.min_active_pressure = 0.0;
   bool first_active = true;
-  std::vector<double> displacement, force;
+  std::vector<double> force;
   for (std::size_t p = 0; p < pairs_.size(); ++p) {
     auto& pair = pairs_[p];
-    const auto position = [&](const Surface& s, const SurfaceGather& gather,
-                              std::vector<double>& x) {
-      gather.gather(u, displacement);
-      x = s.reference;
-      for (std::size_t k = 0; k < x.size(); ++k) x[k] += displacement[k];
-    };
-    position(pair.slave, *slave_gathers_[p], pair.slave_x);
-    position(pair.master, *master_gathers_[p], pair.master_x);
+    current_positions(p, u, pair.slave_x, pair.master_x);
     slave_gathers_[p]->gather(residual, force);
     pair.mortar =
         assemble_mortar(pair.slave, pair.slave_x, pair.master, pair.master_x, mortar_options(p));
@@ -190,6 +183,18 @@ void ContactConstraints::update(Vec u, Vec residual) {
   COAPT_PETSC_CHECK(VecCopy(work_, residual));
 }
 
+void ContactConstraints::current_positions(std::size_t p, Vec u, std::vector<double>& slave_x,
+                                           std::vector<double>& master_x) const {
+  const auto& pair = pairs_[p];
+  std::vector<double> displacement;
+  slave_gathers_[p]->gather(u, displacement);
+  slave_x = pair.slave.reference;
+  for (std::size_t k = 0; k < slave_x.size(); ++k) slave_x[k] += displacement[k];
+  master_gathers_[p]->gather(u, displacement);
+  master_x = pair.master.reference;
+  for (std::size_t k = 0; k < master_x.size(); ++k) master_x[k] += displacement[k];
+}
+
 MortarOptions ContactConstraints::mortar_options(std::size_t p) const {
   MortarOptions options;
   options.search_distance =
@@ -209,15 +214,12 @@ int ContactConstraints::project_predictor(Vec u, Vec increment) {
   // loses its penetrating normal part: δ_j ← δ_j + g_j' n_j, so g_j' becomes 0. The master's
   // increment is kept (exact for a fixed master; with two deformable bodies the projection
   // is a small quadratic program, method/notes.md, which this node-wise clip approximates).
-  std::vector<double> displacement, slave_increment, master_increment;
+  std::vector<double> slave_increment, master_increment;
   int clipped = 0;
   for (std::size_t p = 0; p < pairs_.size(); ++p) {
     const auto& pair = pairs_[p];
-    std::vector<double> slave_x = pair.slave.reference, master_x = pair.master.reference;
-    slave_gathers_[p]->gather(u, displacement);
-    for (std::size_t k = 0; k < slave_x.size(); ++k) slave_x[k] += displacement[k];
-    master_gathers_[p]->gather(u, displacement);
-    for (std::size_t k = 0; k < master_x.size(); ++k) master_x[k] += displacement[k];
+    std::vector<double> slave_x, master_x;
+    current_positions(p, u, slave_x, master_x);
     slave_gathers_[p]->gather(increment, slave_increment);
     master_gathers_[p]->gather(increment, master_increment);
     const auto m = assemble_mortar(pair.slave, slave_x, pair.master, master_x, mortar_options(p));

@@ -119,6 +119,9 @@ class ContactConstraints {
 
  private:
   void build_row_operator();
+  /// The current coordinates X + u of pair p's slave and master nodes (n × dim). Collective.
+  void current_positions(std::size_t p, Vec u, std::vector<double>& slave_x,
+                         std::vector<double>& master_x) const;
   /// The mortar search and integration options of pair p.
   MortarOptions mortar_options(std::size_t p) const;
 
