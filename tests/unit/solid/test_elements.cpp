@@ -11,6 +11,7 @@
 
 #include "coapt/fem/kernels.hpp"
 #include "coapt/solid/elements.hpp"
+#include "element_test_support.hpp"
 
 namespace coapt::solid {
 namespace {
@@ -29,21 +30,10 @@ std::vector<Material> all_materials() {
 }
 
 FibreDirections fibres() {
-  FibreDirections f;
-  f.a0[0] = Vector3(1.0, 1.0, 0.0).normalized();
-  f.a0[1] = Vector3(1.0, -0.5, 0.0).normalized();
-  return f;
+  return testing::two_fibre_families();
 }
 
-template <int Dim>
-NodalValues<Dim> reference_cell() {
-  NodalValues<Dim> x;
-  if constexpr (Dim == 2)
-    x << 0.1, 0.0, 1.2, 0.2, 0.3, 0.9;
-  else
-    x << 0.0, 0.1, 0.0, 1.1, 0.0, 0.2, 0.2, 0.9, 0.1, 0.1, 0.3, 1.0;
-  return x;
-}
+using testing::reference_cell;
 
 // A moderately large displacement (|H| ~ 0.2): fibres stretched, J ≠ 1.
 template <int Dim>
