@@ -4,9 +4,10 @@
 // pulled down by a dead traction of 1 kPa on x = 1, in one load step. Reported: wall time per
 // Newton iteration, split into assembly (residual and tangent) and linear solve, with the
 // solver of the options (displacement formulation: default GMRES + GAMG with the rigid-body
-// near-null space; --formulation mixed: the P1-P1 displacement-pressure form with MUMPS LU;
-// PETSc options with the prefix solid_ after --), and the Krylov iterations per Newton
-// iteration.
+// near-null space; --formulation mixed: the P1-P1 displacement-pressure form with its default
+// GMRES + fieldsplit Schur preconditioner of solid/mixed_solver.hpp, or MUMPS LU with
+// -- -solid_ksp_type preonly -solid_pc_type lu; PETSc options with the prefix solid_ after --),
+// and the Krylov iterations per Newton iteration.
 
 #include <fmt/format.h>
 #include <unistd.h>

@@ -29,6 +29,7 @@
 #include "coapt/solid/dynamics.hpp"
 #include "coapt/solid/elements.hpp"
 #include "coapt/solid/mixed_elements.hpp"
+#include "coapt/solid/mixed_solver.hpp"
 
 namespace coapt::solid {
 namespace detail {
@@ -750,15 +751,6 @@ class SolidModelImpl {
     mixed_state_ = fem::create_vertex_vector(mesh_, m);
     mixed_residual_ = fem::create_vertex_vector(mesh_, m);
     mixed_matrix_.emplace(mesh_, m);
-    // A direct solver: the stabilised saddle-point system is indefinite, and AMG on it needs a
-    // block preconditioner; -solid_ksp_type / -solid_pc_type choose another.
-    mixed_solver_.emplace(comm_, "solid_",
-                          fem::LinearSolverDefaults{"preonly", "lu", 1e-10, 1e-50, 2000});
-    PetscBool given = PETSC_FALSE;
-    COAPT_PETSC_CHECK(PetscOptionsHasName(nullptr, "solid_", "-pc_factor_mat_solver_type", &given));
-    PC pc = nullptr;
-    COAPT_PETSC_CHECK(KSPGetPC(mixed_solver_->ksp(), &pc));
-    if (!given) COAPT_PETSC_CHECK(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
     for (PetscInt dof : dirichlet_dofs_)
       mixed_dirichlet_dofs_.push_back(dof / dim_ * m + dof % dim_);
     cell_size_.resize(static_cast<std::size_t>(mesh_.n_cells()));
@@ -790,6 +782,26 @@ class SolidModelImpl {
       shear_max = std::max(shear_max, shear);
     }
     pressure_scale_ = shear_max / (sums[0] / sums[1]);
+    // The linear solver (mixed_solver.hpp) and the lumped pressure mass S² |T|/((Dim+1) μ_T)
+    // of its Schur-complement preconditioner (S²: the pressure rows and columns hold p / S).
+    auto pressure_mass = fem::create_vertex_vector(mesh_, m);
+    COAPT_PETSC_CHECK(VecSet(pressure_mass, 0.0));
+    for (int c = 0; c < mesh_.n_owned_cells; ++c) {
+      double bulk = 0, shear = 0;
+      volumetric_split(body(c).material, bulk, shear);
+      const double weight = pressure_scale_ * pressure_scale_ *
+                            std::abs(mesh::cell_signed_measure(mesh_, c)) / (dim_ + 1) / shear;
+      for (const int v : mesh_.cell(c))
+        COAPT_PETSC_CHECK(
+            VecSetValue(pressure_mass, mesh_.global_vertex[v] * m + dim_, weight, ADD_VALUES));
+    }
+    COAPT_PETSC_CHECK(VecAssemblyBegin(pressure_mass));
+    COAPT_PETSC_CHECK(VecAssemblyEnd(pressure_mass));
+    mixed_solver_.emplace(mesh_, pressure_mass);
+    // The block preconditioner's sub-matrices are re-extracted in place at every Newton
+    // iteration: the Dirichlet elimination must keep the CSR pattern.
+    if (mixed_solver_->block_preconditioner())
+      COAPT_PETSC_CHECK(MatSetOption(mixed_matrix_->mat(), MAT_KEEP_NONZERO_PATTERN, PETSC_TRUE));
   }
 
   void zero_mixed_dirichlet(Vec vector) {
@@ -1517,7 +1529,7 @@ class SolidModelImpl {
   // Mixed formulation (parameters_.mixed): state (u, p) per vertex, residual, matrix, solver.
   OwnedVec mixed_state_, mixed_residual_;
   std::optional<fem::P1Matrix> mixed_matrix_;
-  std::optional<fem::LinearSolver> mixed_solver_;
+  std::optional<MixedLinearSolver> mixed_solver_;
   std::vector<PetscInt> mixed_dirichlet_dofs_;  ///< owned, in the (Dim+1)-component layout
   std::vector<double> cell_size_;               ///< longest edge of each local cell [m]
   double pressure_scale_ = 1.0;                 ///< S: the mixed state holds p / S [Pa]
