@@ -9,15 +9,18 @@ time, the Windkessel states and the benchmark histories.
   bit for bit as the run of 10 steps straight through; restarted on 1 and 3 ranks (another
   partition), the last row agrees to 1e-8 relative;
 - the tube with a Windkessel outlet (cases/tube_windkessel.yaml, level 0, 3D), 6 steps of
-  0.04 s: 3 + 3 steps on 2 ranks give steps 4..6 and the benchmark (the RCR check over the
-  whole outlet history) bit for bit, and the Windkessel state at the end is the same;
+  0.04 s: 3 + 3 steps on 1 rank give the outlet pressure and flows of steps 4..6, the
+  benchmark (the RCR check over the whole outlet history) and the Windkessel state at the end
+  to 1e-10 relative. Not bit for bit: this 3D case is not reproducible run to run (two
+  identical runs, on 1 or 2 ranks and with the solver below, differ by ~1e-15 relative from
+  the 3rd step on; cause not found). A Windkessel state not restored would change the
+  pressure by far more (P_c is most of P);
 - a checkpoint of a solid run, a checkpoint of another mesh and a steady case are refused with
   one error line naming the folder, exit 2.
 The linear solver is PETSc's own LU of the gathered matrix without a Krylov wrapper
 (-fluid_ksp_type preonly -fluid_pc_type redundant): the defaults are not bitwise reproducible on
-2 ranks — two identical 2-rank runs differ by ~1e-15 relative after a few steps with MUMPS LU
-(2D), with GMRES + fieldsplit/hypre and also with GMRES + redundant LU (3D tube) — so no
-restart could be."""
+2 ranks — two identical 2-rank runs of DFG 2D-2 with MUMPS LU differ by ~1e-15 relative from
+the 4th step on — so no restart could be."""
 
 import csv
 
@@ -86,18 +89,31 @@ def main():
                       f"(largest relative difference {worst:.2e})")
 
     tube = {
-        "tube": run("tube_windkessel.yaml", "tube", 0.24, *TUBE),
-        "tube-first": run("tube_windkessel.yaml", "tube-first", 0.12, *TUBE),
+        "tube": run("tube_windkessel.yaml", "tube", 0.24, *TUBE, ranks=1),
+        "tube-first": run("tube_windkessel.yaml", "tube-first", 0.12, *TUBE, ranks=1),
     }
     tube["tube-again"] = run("tube_windkessel.yaml", "tube-again", 0.24, *TUBE, "--restart",
-                             work / "tube-first")
+                             work / "tube-first", ranks=1)
     for name, result in tube.items():
         runner.expect(result.returncode == 0, f"tube {name} run succeeds",
                       result.stdout[-3000:] + result.stderr)
     if all(result.returncode == 0 for result in tube.values()):
-        a, b = same("tube", "tube", "tube-again", 3)
-        runner.expect(a["windkessel_state"] == b["windkessel_state"],
-                      "tube, same ranks: the Windkessel state at the end bit for bit")
+        reference = rows(work / "tube" / "series.csv")[3:]
+        again = rows(work / "tube-again" / "series.csv")
+        keys = ("outlet_pressure_outlet", "outlet_flow_outlet", "flow_inlet")
+        worst = max((abs(float(a[k]) / float(b[k]) - 1) for a, b in zip(again, reference)
+                     for k in keys), default=1.0)
+        runner.expect(len(again) == 3 and [a["time"] for a in again] == [b["time"] for b in reference]
+                      and worst < 1e-10,
+                      f"tube: steps 4..6 agree with the straight run to 1e-10 ({worst:.1e})")
+        a = read_json(work / "tube" / "summary.json")
+        b = read_json(work / "tube-again" / "summary.json")
+        pairs = [(a["benchmark"][k], b["benchmark"][k]) for k in a["benchmark"]]
+        for group in a["windkessel_state"]:
+            pairs += list(zip(a["windkessel_state"][group], b["windkessel_state"][group]))
+        worst = max(abs(x - y) / max(abs(x), 1e-300) for x, y in pairs)
+        runner.expect(worst < 1e-10, "tube: the benchmark (RCR check over the whole history) and "
+                      f"the Windkessel state at the end agree to 1e-10 ({worst:.1e})")
 
     def refused(result, what, needle):
         errors = [line for line in result.stderr.splitlines() if "error:" in line]
