@@ -273,8 +273,8 @@ struct Solid {
   OwnedVec applied_previous;  ///< iqn_ils: the applied force of the last iterate
 };
 
-/// Adds the contact hook's time since `start` to the stage "contact" when it goes out of scope
-/// (a solid solve, also one that throws).
+/// Adds the contact hook's time over its own lifetime (one solid solve, also one that throws)
+/// to the stage "contact".
 class ContactTime {
  public:
   ContactTime(StageTimers& timers, const contact::ContactHook* hook)
