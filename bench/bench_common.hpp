@@ -4,6 +4,7 @@
 #include <mpi.h>
 
 #include <string>
+#include <vector>
 
 #include "coapt/core/context.hpp"
 #include "coapt/io/json.hpp"
@@ -57,5 +58,16 @@ struct ContactBenchOptions {
 /// mortar contact: time per load step, Newton iterations and active-set changes
 /// (bench_contact.cpp). Collective.
 io::Json contact(const Context& context, const ContactBenchOptions& options);
+
+struct FsciBenchOptions {
+  std::string case_file = COAPT_SOURCE_DIR "/cases/valve2d.yaml";
+  int level = 0;                          ///< mesh.level
+  int steps = 5;                          ///< time steps (end_time = steps · time.step)
+  std::string output = "bench-fsci-run";  ///< the run folder
+  std::vector<std::string> assignments;   ///< --set key=value
+};
+/// `coapt-bench fsci`: a transient coupled run of a case for some steps, the wall time per
+/// stage of the coupled problem (bench_fsci.cpp). Collective.
+io::Json fsci(const Context& context, const FsciBenchOptions& options);
 
 }  // namespace coapt::bench

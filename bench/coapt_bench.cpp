@@ -4,6 +4,7 @@
 //   mpirun -np 2 coapt-bench fluid --n 12 -- -fluid_pc_type lu
 //   mpirun -np 2 coapt-bench solid --n 44
 //   mpirun -np 2 coapt-bench contact --level 1 --size 4.5e-4
+//   mpirun -np 2 coapt-bench fsci --case cases/valve2d.yaml --steps 5
 //
 // Each sub-command prints what it does and ends with one line holding a JSON object of the
 // figures (rates carry their unit in the key) and the peak memory per rank (peak_rss_mb).
@@ -66,6 +67,16 @@ int main(int argc, char** argv) {
   contact_command
       ->add_option("--steps", contact.steps, "run only the first this many load steps (0: all)")
       ->check(CLI::Range(0, 100000));
+  coapt::bench::FsciBenchOptions fsci;
+  auto* fsci_command = app.add_subcommand(
+      "fsci",
+      "a transient coupled run (problem: fsci, default cases/valve2d.yaml) for some steps: wall "
+      "time per stage (solid, contact, transfer, fluid, coupling)");
+  fsci_command->add_option("--case", fsci.case_file, "the fsci case file");
+  fsci_command->add_option("--level", fsci.level, "mesh.level")->check(CLI::Range(0, 6));
+  fsci_command->add_option("--steps", fsci.steps, "time steps")->check(CLI::Range(1, 100000));
+  fsci_command->add_option("--output", fsci.output, "the run folder");
+  fsci_command->add_option("--set", fsci.assignments, "override a case key (key=value)");
   try {
     app.parse(n_ours, argv);
   } catch (const CLI::ParseError& e) {
@@ -80,6 +91,7 @@ int main(int argc, char** argv) {
     if (*fluid_command) figures = coapt::bench::fluid(context, fluid);
     if (*solid_command) figures = coapt::bench::solid(context, solid);
     if (*contact_command) figures = coapt::bench::contact(context, contact);
+    if (*fsci_command) figures = coapt::bench::fsci(context, fsci);
     figures["peak_rss_mb"] = coapt::bench::peak_rss_mb(context.comm());
     if (context.rank() == 0) std::cout << figures.dump(-1) << std::endl;
   } catch (const coapt::Error& e) {

@@ -6,6 +6,11 @@ Newmark free vibration (cases/solid/vibration.yaml, 40 steps):
   gives steps 21..40 of series.csv and the summary's benchmark bit for bit as the run of 40
   steps straight through;
 - restarted on 1 and 3 ranks (another partition), the same to 1e-9 relative (solver tolerance);
+- the ball in a box (cases/ball_in_box.yaml, contact-stabilized Newmark with mortar contact)
+  checkpointed at step 260, inside its first impact (7 active nodes), and restarted to step
+  300 on 1 rank gives steps 261..300 (active nodes, active-set changes, contact force, energy)
+  and the impact benchmark bit for bit: the active set and the complementarity constant come
+  back with the Newmark state;
 - a missing checkpoint folder, a checkpoint of another mesh and a quasi-static case are refused
   with one error line naming the folder, exit 2."""
 
@@ -66,6 +71,29 @@ def main():
             worst = max(worst, abs(a - b) / abs(b))
         runner.expect(worst < 1e-9, f"restart on {ranks} rank(s): step 40 agrees to 1e-9",
                       f"largest relative difference {worst:.3e}")
+
+    ball = runner.source / "cases" / "ball_in_box.yaml"
+
+    def run_ball(output, end_time, *extra):
+        return runner.run("run", ball, "--output", work / output, "--set", "output.vtk=false",
+                          "--set", f"time.end_time={end_time}", "--set",
+                          "output.checkpoint_interval=130", *extra, ranks=1)
+
+    results = [run_ball("ball", 30), run_ball("ball-first", 26)]
+    results.append(run_ball("ball-again", 30, "--restart", work / "ball-first"))
+    runner.expect(all(result.returncode == 0 for result in results), "ball in a box runs succeed",
+                  "\n".join(result.stderr for result in results))
+    if all(result.returncode == 0 for result in results):
+        reference = rows(work / "ball" / "series.csv")
+        restarted = rows(work / "ball-again" / "series.csv")
+        runner.expect(int(float(reference[260]["contact_active_nodes"])) > 0,
+                      "the ball is in contact at the checkpoint (step 260)")
+        runner.expect(restarted == reference[261:],
+                      "ball in a box: steps 261..300 bit for bit as the straight run",
+                      f"{len(restarted)} rows restarted")
+        runner.expect(read_json(work / "ball" / "summary.json")["benchmark"] ==
+                      read_json(work / "ball-again" / "summary.json")["benchmark"],
+                      "ball in a box: the benchmark (impacts, contact) bit for bit")
 
     def refused(result, what, needle):
         errors = [line for line in result.stderr.splitlines() if "error:" in line]

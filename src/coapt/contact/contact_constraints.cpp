@@ -183,6 +183,27 @@ void ContactConstraints::update(Vec u, Vec residual) {
   COAPT_PETSC_CHECK(VecCopy(work_, residual));
 }
 
+void ContactConstraints::active_marker(std::size_t p, Vec marker) const {
+  COAPT_PETSC_CHECK(VecSet(marker, 0.0));
+  const auto& pair = pairs_[p];
+  PetscScalar* values = nullptr;
+  COAPT_PETSC_CHECK(VecGetArray(marker, &values));
+  for (int j = 0; j < pair.slave.n_nodes(); ++j) {
+    const PetscInt first = pair.slave.global_vertex[j] * dim_;
+    if (!pair.active[j] || first < first_dof_ || first >= end_dof_) continue;
+    for (int i = 0; i < dim_; ++i) values[first - first_dof_ + i] = 1.0;
+  }
+  COAPT_PETSC_CHECK(VecRestoreArray(marker, &values));
+}
+
+void ContactConstraints::restore_active(std::size_t p, Vec marker) {
+  std::vector<double> values;
+  slave_gathers_[p]->gather(marker, values);
+  auto& pair = pairs_[p];
+  for (int j = 0; j < pair.slave.n_nodes(); ++j)
+    pair.active[j] = values[static_cast<std::size_t>(j) * dim_] > 0.5 ? 1 : 0;
+}
+
 void ContactConstraints::current_positions(std::size_t p, Vec u, std::vector<double>& slave_x,
                                            std::vector<double>& master_x) const {
   const auto& pair = pairs_[p];

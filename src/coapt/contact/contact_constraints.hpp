@@ -108,6 +108,20 @@ class ContactConstraints {
   /// Forgets the previous active set's change count (a new step). Not collective.
   void begin_step() { settled_updates_ = 0; }
 
+  /// Pair p's active set into `marker` (a vector with the layout given at construction): 1 in
+  /// every component of its active slave nodes, 0 elsewhere (owned entries; for a
+  /// checkpoint). Collective.
+  void active_marker(std::size_t p, Vec marker) const;
+  /// Takes pair p's active set back from such a marker: the next update counts its changes
+  /// against it. Collective.
+  void restore_active(std::size_t p, Vec marker);
+  /// c [Pa/m] in use (0: computed at the next transform from the stiffness).
+  double complementarity_constant() const { return complementarity_constant_; }
+  void set_complementarity_constant(double c) {
+    complementarity_constant_ = c;
+    status_.complementarity_constant = c;
+  }
+
   const ContactStatus& status() const { return status_; }
   const std::vector<PairState>& pairs() const { return pairs_; }
   /// Vertex fields over the local vertices of the mesh (owned and ghost): contact pressure

@@ -2,6 +2,7 @@
 #include "coapt/contact/solid_contact.hpp"
 
 #include <fmt/format.h>
+#include <mpi.h>
 #include <petscsys.h>
 
 #include <algorithm>
@@ -13,6 +14,7 @@
 
 #include "coapt/core/error.hpp"
 #include "coapt/core/log.hpp"
+#include "coapt/fem/assembly.hpp"
 
 namespace coapt::contact {
 
@@ -191,7 +193,35 @@ double surface_distance(const PairState& pair) {
 
 ContactHook::ContactHook(const ContactParameters& parameters, const solid::SolidModel& solid)
     : parameters_(parameters),
+      mesh_(solid.mesh()),
       constraints_(parameters, solid.mesh(), solid.dirichlet_dofs(), solid.displacement()) {}
+
+void ContactHook::write_checkpoint(run::CheckpointWriter& writer, const std::string& prefix) const {
+  auto marker = fem::create_vertex_vector(mesh_, mesh_.dim);
+  for (std::size_t p = 0; p < constraints_.pairs().size(); ++p) {
+    constraints_.active_marker(p, marker);
+    writer.add_vertex_field(fmt::format("{}active{}", prefix, p), mesh_, marker, mesh_.dim);
+  }
+  auto& state = writer.state()[prefix + "contact"];
+  state["pairs"] = static_cast<std::int64_t>(constraints_.pairs().size());
+  state["complementarity_constant"] = constraints_.complementarity_constant();
+}
+
+void ContactHook::read_checkpoint(const run::CheckpointReader& reader, const std::string& prefix) {
+  const auto& checkpoint = reader.state();
+  const auto key = prefix + "contact";
+  if (!checkpoint.contains(key) || checkpoint.at(key).at("pairs").as_int() !=
+                                       static_cast<std::int64_t>(constraints_.pairs().size()))
+    throw InputError(fmt::format("{}: the checkpoint's contact state ({}) is not of {} pair(s)",
+                                 reader.directory().string(), key, constraints_.pairs().size()));
+  auto marker = fem::create_vertex_vector(mesh_, mesh_.dim);
+  for (std::size_t p = 0; p < constraints_.pairs().size(); ++p) {
+    reader.read_vertex_field(fmt::format("{}active{}", prefix, p), mesh_, marker, mesh_.dim);
+    constraints_.restore_active(p, marker);
+  }
+  constraints_.set_complementarity_constant(
+      checkpoint.at(key).at("complementarity_constant").as_double());
+}
 
 void ContactHook::begin_step(Vec u) {
   (void)u;
@@ -201,12 +231,17 @@ void ContactHook::begin_step(Vec u) {
 }
 
 void ContactHook::add_residual(Vec u, Vec residual) {
+  const double start = MPI_Wtime();
   constraints_.update(u, residual);
+  seconds_ += MPI_Wtime() - start;
 }
 
 Mat ContactHook::linear_system(Vec u, Mat K, Vec rhs) {
   (void)u;
-  return constraints_.transform(K, rhs);
+  const double start = MPI_Wtime();
+  Mat system = constraints_.transform(K, rhs);
+  seconds_ += MPI_Wtime() - start;
+  return system;
 }
 
 bool ContactHook::accept(Vec u) {
@@ -227,7 +262,9 @@ bool ContactHook::accept(Vec u) {
 }
 
 void ContactHook::project_predictor(Vec u, Vec increment) {
+  const double start = MPI_Wtime();
   const int clipped = constraints_.project_predictor(u, increment);
+  seconds_ += MPI_Wtime() - start;
   if (clipped > 0) log::debug("contact: the predictor was clipped at {} slave node(s)", clipped);
 }
 

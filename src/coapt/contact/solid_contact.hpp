@@ -111,12 +111,23 @@ class ContactHook final : public solid::NewtonHook {
   void write_nodes(const std::filesystem::path& file, MPI_Comm comm) const;
   /// Logs the contact state after a step.
   void log_status(const std::string& label) const;
+  /// Wall time spent in the contact update, the Newton matrix transformation and the
+  /// predictor projection since construction [s] (this rank).
+  double seconds() const { return seconds_; }
+  /// Adds the contact state that carries over to the next step to a checkpoint: each pair's
+  /// active set (field `prefix`active<p>, 1 at active slave nodes) and the complementarity
+  /// constant (state[`prefix`contact]). Collective.
+  void write_checkpoint(run::CheckpointWriter& writer, const std::string& prefix) const;
+  /// Takes it back; InputError naming the checkpoint folder when its pairs are not these.
+  void read_checkpoint(const run::CheckpointReader& reader, const std::string& prefix);
 
  private:
   ContactParameters parameters_;
+  const mesh::Mesh& mesh_;
   ContactConstraints constraints_;
   int changing_iterations_ = 0;
   int changed_nodes_ = 0;
+  double seconds_ = 0;
   std::vector<double> pressure_, gap_, active_;
 };
 

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <limits>
 #include <memory>
 
@@ -77,7 +78,8 @@ struct Parameters {
   fluid::TimeSettings time;
   Benchmark benchmark;
   bool write_vtk = true;
-  int vtk_interval = 0;  ///< transient: VTK every this many steps (0: the last step only)
+  int vtk_interval = 0;         ///< transient: VTK every this many steps (0: the last step only)
+  int checkpoint_interval = 0;  ///< transient: a checkpoint every this many steps (0: none)
 };
 
 Parameters read(const config::Section& root) {
@@ -247,6 +249,10 @@ Parameters read(const config::Section& root) {
       output.get<int>("vtk_interval", 0,
                       {"", "transient: VTK every this many time steps (0: only at the end)",
                        Bounds::closed(0, 1000000)});
+  p.checkpoint_interval =
+      output.get<int>("checkpoint_interval", 0,
+                      {"", "transient: time steps between checkpoints for --restart (0: none)",
+                       Bounds::closed(0, 1000000)});
   return p;
 }
 
@@ -265,6 +271,24 @@ struct Solid {
   // and the last residual f − f_applied (Aitken)
   OwnedVec applied, applied_start, residual, previous_residual;
   OwnedVec applied_previous;  ///< iqn_ils: the applied force of the last iterate
+};
+
+/// Adds the contact hook's time over its own lifetime (one solid solve, also one that throws)
+/// to the stage "contact".
+class ContactTime {
+ public:
+  ContactTime(StageTimers& timers, const contact::ContactHook* hook)
+      : timers_(timers), hook_(hook), start_(hook ? hook->seconds() : 0.0) {}
+  ContactTime(const ContactTime&) = delete;
+  ContactTime& operator=(const ContactTime&) = delete;
+  ~ContactTime() {
+    if (hook_) timers_.add("contact", hook_->seconds() - start_);
+  }
+
+ private:
+  StageTimers& timers_;
+  const contact::ContactHook* hook_;
+  double start_;
 };
 
 /// What the coupling iterations of one step did.
@@ -369,6 +393,28 @@ class FsciProblem final : public run::Problem {
               : std::string());
   }
 
+  /// Transient runs continue from a checkpoint of an earlier run (written every
+  /// output.checkpoint_interval steps): the whole coupled state (write_checkpoint). The reader
+  /// must live until run() returns.
+  void restart_from(const run::CheckpointReader& checkpoint) override {
+    const auto folder = checkpoint.directory().string();
+    if (parameters_.time.steady)
+      throw InputError(fmt::format("--restart {}: a steady fsci run has no checkpoints", folder));
+    const auto& state = checkpoint.state();
+    const std::string kind = state.contains("problem") ? state.at("problem").as_string() : "solid";
+    if (kind != "fsci")
+      throw InputError(
+          fmt::format("--restart {}: a checkpoint of a '{}' run, this case is fsci", folder, kind));
+    std::vector<std::string> written, ours;
+    for (const auto& name : state.at("solids").as_array()) written.push_back(name.as_string());
+    for (const auto& solid : solids_) ours.push_back(solid->entry->name);
+    if (written != ours)
+      throw InputError(
+          fmt::format("--restart {}: the checkpoint's solids ({}) are not the case's ({})", folder,
+                      fmt::join(written, ", "), fmt::join(ours, ", ")));
+    restart_ = &checkpoint;
+  }
+
   void run(run::RunOutput& output) override {
     describe();
     fluid_.start(0.0);
@@ -417,6 +463,10 @@ class FsciProblem final : public run::Problem {
     } else {
       Progress progress(p.time.n_steps(), p.time.end_time);
       int step = 0;
+      if (restart_) {
+        step = n_steps_done = read_checkpoint(*restart_);
+        log::info("continuing after step {} (t = {:g} s)", step, fluid_.time());
+      }
       while (fluid_.time() < p.time.end_time * (1 - 1e-12)) {
         const double dt = std::min(p.time.time_step, p.time.end_time - fluid_.time());
         CouplingReport report;
@@ -439,6 +489,10 @@ class FsciProblem final : public run::Problem {
           ScopedTimer timer(output.timers(), "output");
           write_vtk(output, fluid_.time());
           last_vtk_step = step;
+        }
+        if (p.checkpoint_interval > 0 && step % p.checkpoint_interval == 0) {
+          ScopedTimer timer(output.timers(), "checkpoint");
+          write_checkpoint(output, step);
         }
         progress.step(
             std::min(step, p.time.n_steps()), fluid_.time(),
@@ -465,6 +519,202 @@ class FsciProblem final : public run::Problem {
     bool converged = false;
     CouplingReport coupling;
   };
+
+  /// The coupled state after `step` committed steps into output/checkpoint: the fluid's BDF
+  /// history and Windkessels (FluidModel::write_checkpoint); per solid k (fields solid<k>_...)
+  /// its constrained fluid nodes and frozen flag, its force Bᵀλ, and for a deformable solid
+  /// the committed Newmark state, the applied (relaxed) force that starts the next step and
+  /// the contact state, for a rigid one its coordinates; the IQN-ILS columns kept for reuse;
+  /// the valve history.
+  void write_checkpoint(run::RunOutput& output, int step) const {
+    run::CheckpointWriter writer(comm_, output.directory() / "checkpoint");
+    auto& state = writer.state();
+    state["problem"] = "fsci";
+    state["step"] = step;
+    state["force_balance"] = force_balance_;
+    fluid_.write_checkpoint(writer);
+    const auto& fluid_mesh = fluid_.mesh();
+    auto marker = fem::create_vertex_vector(fluid_mesh, 1);
+    auto& names = state["solids"] = io::Json::array();
+    for (std::size_t k = 0; k < solids_.size(); ++k) {
+      const auto& solid = *solids_[k];
+      const auto prefix = fmt::format("solid{}_", k);
+      const int dim = solid.mesh.dim;
+      names.push_back(solid.entry->name);
+      state[prefix + "frozen"] = solid.constraint->frozen();
+      COAPT_PETSC_CHECK(VecSet(marker, 0.0));
+      {
+        PetscScalar* values = nullptr;
+        COAPT_PETSC_CHECK(VecGetArray(marker, &values));
+        for (const int v : solid.constraint->constrained_vertices()) values[v] = 1.0;
+        COAPT_PETSC_CHECK(VecRestoreArray(marker, &values));
+      }
+      writer.add_vertex_field(prefix + "constrained", fluid_mesh, marker, 1);
+      writer.add_vertex_field(prefix + "force", solid.mesh, solid.force, dim);
+      if (solid.model) {
+        solid.model->write_checkpoint(writer, prefix);
+        writer.add_vertex_field(prefix + "applied", solid.mesh, solid.applied, dim);
+        if (solid.contact) solid.contact->write_checkpoint(writer, prefix);
+      } else {
+        auto coordinates = fem::create_vertex_vector(solid.mesh, dim);
+        PetscScalar* values = nullptr;
+        COAPT_PETSC_CHECK(VecGetArray(coordinates, &values));
+        std::copy_n(solid.mesh.coordinates.begin(),
+                    static_cast<std::size_t>(solid.mesh.n_owned_vertices) * dim, values);
+        COAPT_PETSC_CHECK(VecRestoreArray(coordinates, &values));
+        writer.add_vertex_field(prefix + "x", solid.mesh, coordinates, dim);
+      }
+    }
+    if (quasi_newton_) write_quasi_newton(writer);
+    auto& valve = state["valve"];
+    valve["times"] = io::Json::array_of(valve_.times);
+    valve["opening"] = io::Json::array_of(valve_.opening);
+    valve["flow"] = io::Json::array_of(valve_.flow);
+    valve["closed"] =
+        io::Json::array_of(std::vector<int>(valve_.closed.begin(), valve_.closed.end()));
+    valve["max_penetration"] = valve_.max_penetration;
+    writer.commit();
+  }
+
+  /// Takes the state of write_checkpoint back (after the constraints are built and the solids'
+  /// dynamics initialised); returns the steps done. InputError naming the folder when the
+  /// checkpoint is of other meshes.
+  int read_checkpoint(const run::CheckpointReader& reader) {
+    const auto& state = reader.state();
+    fluid_.read_checkpoint(reader);
+    const auto& fluid_mesh = fluid_.mesh();
+    auto marker = fem::create_vertex_vector(fluid_mesh, 1);
+    for (std::size_t k = 0; k < solids_.size(); ++k) {
+      auto& solid = *solids_[k];
+      const auto prefix = fmt::format("solid{}_", k);
+      const int dim = solid.mesh.dim;
+      reader.read_vertex_field(prefix + "constrained", fluid_mesh, marker, 1);
+      std::vector<int> constrained;
+      {
+        const PetscScalar* values = nullptr;
+        COAPT_PETSC_CHECK(VecGetArrayRead(marker, &values));
+        for (int v = 0; v < fluid_mesh.n_owned_vertices; ++v)
+          if (values[v] > 0.5) constrained.push_back(v);
+        COAPT_PETSC_CHECK(VecRestoreArrayRead(marker, &values));
+      }
+      reader.read_vertex_field(prefix + "force", solid.mesh, solid.force, dim);
+      solid.total_force = solid.constraint->sum_components(solid.force);
+      if (solid.model) {
+        // the applied force first: the contact-stabilized scheme's committed residual uses it
+        reader.read_vertex_field(prefix + "applied", solid.mesh, solid.applied, dim);
+        solid.model->read_checkpoint(reader, prefix);
+        if (solid.contact) solid.contact->read_checkpoint(reader, prefix);
+        solid.mesh.coordinates = solid.model->current_coordinates();
+      } else {
+        auto coordinates = fem::create_vertex_vector(solid.mesh, dim);
+        reader.read_vertex_field(prefix + "x", solid.mesh, coordinates, dim);
+        fem::LocalValues values(coordinates);
+        for (std::size_t i = 0; i < solid.mesh.coordinates.size(); ++i)
+          solid.mesh.coordinates[i] = values[i];
+      }
+      solid.constraint->restore(solid.mesh, std::move(constrained),
+                                state.at(prefix + "frozen").as_bool());
+    }
+    force_balance_ = state.at("force_balance").as_double();
+    if (quasi_newton_) read_quasi_newton(reader);
+    const auto& valve = state.at("valve");
+    const auto doubles = [](const io::Json& array) {
+      std::vector<double> values;
+      for (const auto& value : array.as_array()) values.push_back(value.as_double());
+      return values;
+    };
+    valve_.times = doubles(valve.at("times"));
+    valve_.opening = doubles(valve.at("opening"));
+    valve_.flow = doubles(valve.at("flow"));
+    for (const auto& value : valve.at("closed").as_array())
+      valve_.closed.push_back(value.as_int() != 0 ? 1 : 0);
+    valve_.max_penetration = valve.at("max_penetration").as_double();
+    return static_cast<int>(state.at("step").as_int());
+  }
+
+  /// The IQN-ILS columns kept for reuse, per deformable solid one field solid<k>_iqn with
+  /// 2 dim values per column and vertex (V's, then W's entries of the vertex), the columns of
+  /// the kept steps newest first; state["iqn_columns"]: the columns per kept step.
+  void write_quasi_newton(run::CheckpointWriter& writer) const {
+    const auto& steps = quasi_newton_->reused();
+    std::vector<std::int64_t> counts;
+    std::vector<const std::vector<double>*> columns;  // v₀, w₀, v₁, w₁, ...
+    for (const auto& step : steps) {
+      counts.push_back(static_cast<std::int64_t>(step.v.size()));
+      for (std::size_t j = 0; j < step.v.size(); ++j) {
+        columns.push_back(&step.v[j]);
+        columns.push_back(&step.w[j]);
+      }
+    }
+    writer.state()["iqn_columns"] = io::Json::array_of(counts);
+    if (columns.empty()) return;
+    std::size_t offset = 0;
+    for (std::size_t k = 0; k < solids_.size(); ++k) {
+      const auto& solid = *solids_[k];
+      if (!solid.model) continue;
+      const int dim = solid.mesh.dim, owned = solid.mesh.n_owned_vertices;
+      const int components = static_cast<int>(columns.size()) * dim;
+      OwnedVec packed;
+      COAPT_PETSC_CHECK(VecCreateMPI(comm_, static_cast<PetscInt>(owned) * components,
+                                     PETSC_DETERMINE, packed.out()));
+      PetscScalar* values = nullptr;
+      COAPT_PETSC_CHECK(VecGetArray(packed, &values));
+      for (int v = 0; v < owned; ++v)
+        for (std::size_t c = 0; c < columns.size(); ++c)
+          for (int i = 0; i < dim; ++i)
+            values[static_cast<std::size_t>(v) * components + c * dim + i] =
+                (*columns[c])[offset + static_cast<std::size_t>(v) * dim + i];
+      COAPT_PETSC_CHECK(VecRestoreArray(packed, &values));
+      writer.add_vertex_field(fmt::format("solid{}_iqn", k), solid.mesh, packed, components);
+      offset += static_cast<std::size_t>(owned) * dim;
+    }
+  }
+
+  void read_quasi_newton(const run::CheckpointReader& reader) {
+    std::deque<InterfaceQuasiNewton::Columns> steps;
+    std::size_t n_columns = 0, length = 0;
+    for (const auto& count : reader.state().at("iqn_columns").as_array()) {
+      const auto n = static_cast<std::size_t>(count.as_int());
+      n_columns += n;
+      steps.emplace_back();
+      steps.back().v.resize(n);
+      steps.back().w.resize(n);
+    }
+    for (const auto& solid : solids_)
+      if (solid->model)
+        length += static_cast<std::size_t>(solid->mesh.n_owned_vertices) * solid->mesh.dim;
+    std::vector<std::vector<double>*> columns;
+    for (auto& step : steps)
+      for (std::size_t j = 0; j < step.v.size(); ++j) {
+        step.v[j].resize(length);
+        step.w[j].resize(length);
+        columns.push_back(&step.v[j]);
+        columns.push_back(&step.w[j]);
+      }
+    if (n_columns > 0) {
+      std::size_t offset = 0;
+      for (std::size_t k = 0; k < solids_.size(); ++k) {
+        const auto& solid = *solids_[k];
+        if (!solid.model) continue;
+        const int dim = solid.mesh.dim, owned = solid.mesh.n_owned_vertices;
+        const int components = static_cast<int>(columns.size()) * dim;
+        OwnedVec packed;
+        COAPT_PETSC_CHECK(VecCreateMPI(comm_, static_cast<PetscInt>(owned) * components,
+                                       PETSC_DETERMINE, packed.out()));
+        reader.read_vertex_field(fmt::format("solid{}_iqn", k), solid.mesh, packed, components);
+        const PetscScalar* values = nullptr;
+        COAPT_PETSC_CHECK(VecGetArrayRead(packed, &values));
+        for (int v = 0; v < owned; ++v)
+          for (std::size_t c = 0; c < columns.size(); ++c)
+            for (int i = 0; i < dim; ++i)
+              (*columns[c])[offset + static_cast<std::size_t>(v) * dim + i] =
+                  values[static_cast<std::size_t>(v) * components + c * dim + i];
+        COAPT_PETSC_CHECK(VecRestoreArrayRead(packed, &values));
+        offset += static_cast<std::size_t>(owned) * dim;
+      }
+    }
+    quasi_newton_->restore_reused(std::move(steps));
+  }
 
   Solid* find_solid(const std::string& name) const {
     for (const auto& solid : solids_)
@@ -550,7 +800,9 @@ class FsciProblem final : public run::Problem {
       for (auto& solid : solids_) {  // (1) and (2)
         if (!solid->model) continue;
         {
+          // "solid" includes the contact hook's share, reported again as "contact"
           ScopedTimer timer(output.timers(), "solid");
+          const ContactTime contact_time(output.timers(), solid->contact.get());
           try {
             if (steady)
               solid->model->solve_static(
@@ -1002,6 +1254,7 @@ class FsciProblem final : public run::Problem {
     double max_penetration = 0;
   } valve_;
   int probe_index_ = -1;  ///< benchmark.probe in its solid's probes
+  const run::CheckpointReader* restart_ = nullptr;
 };
 
 }  // namespace

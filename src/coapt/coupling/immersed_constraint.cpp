@@ -28,6 +28,14 @@ void ImmersedConstraint::update_solid(const mesh::Mesh& moved) {
   collect();
 }
 
+void ImmersedConstraint::restore(const mesh::Mesh& moved, std::vector<int> constrained,
+                                 bool frozen) {
+  constrained_ = std::move(constrained);
+  frozen_ = true;
+  update_solid(moved);
+  frozen_ = frozen;
+}
+
 void ImmersedConstraint::collect() {
   // B ⊗ I_dim acts on interleaved vertex vectors; re-created because update_master may have
   // re-created B.

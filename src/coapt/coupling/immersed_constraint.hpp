@@ -51,6 +51,10 @@ class ImmersedConstraint {
   /// iteration in a limit cycle.
   void set_frozen(bool frozen) { frozen_ = frozen; }
   bool frozen() const { return frozen_; }
+  /// A checkpoint's state: the solid at `moved` with the constrained set it had
+  /// (`constrained`: owned local fluid vertices, ascending; the covered-node rule is not
+  /// applied again) and the frozen flag it had.
+  void restore(const mesh::Mesh& moved, std::vector<int> constrained, bool frozen);
 
   /// Owned local fluid vertices of the constrained set, ascending.
   const std::vector<int>& constrained_vertices() const { return constrained_; }

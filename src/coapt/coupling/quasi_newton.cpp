@@ -37,6 +37,11 @@ void InterfaceQuasiNewton::end_step() {
   current_ = Columns{};
 }
 
+void InterfaceQuasiNewton::restore_reused(std::deque<Columns> columns) {
+  previous_ = std::move(columns);
+  while (static_cast<int>(previous_.size()) > reuse_steps_) previous_.pop_back();
+}
+
 int InterfaceQuasiNewton::next(std::span<const double> x, std::span<const double> x_tilde,
                                double omega, std::span<double> next_x) {
   const std::size_t n = x.size();

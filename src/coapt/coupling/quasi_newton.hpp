@@ -45,10 +45,16 @@ class InterfaceQuasiNewton {
   /// iterates may no longer describe the map).
   void reset();
 
- private:
+  /// The columns of one step: V and W, this rank's entries.
   struct Columns {
     std::vector<std::vector<double>> v, w;  ///< newest last
   };
+  /// The past steps' columns kept for reuse, newest first (for a checkpoint, between steps).
+  const std::deque<Columns>& reused() const { return previous_; }
+  /// Replaces them (from a checkpoint; at most reuse_steps are kept).
+  void restore_reused(std::deque<Columns> columns);
+
+ private:
   double dot(std::span<const double> a, std::span<const double> b) const;
 
   MPI_Comm comm_;

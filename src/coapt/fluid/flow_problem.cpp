@@ -47,6 +47,7 @@ struct Parameters {
   TimeSettings time;
   Benchmark benchmark;
   bool write_vtk = true;
+  int checkpoint_interval = 0;  ///< transient: a checkpoint every this many steps (0: none)
 };
 
 Parameters read(const config::Section& root) {
@@ -106,8 +107,12 @@ Parameters read(const config::Section& root) {
           reference.get<double>("lift", 0.0, {"N/m", "lift force (per unit depth; 0: none)"});
     }
   }
-  p.write_vtk = root.section("output", "what the run writes")
-                    .get<bool>("vtk", true, {"", "write velocity and pressure as VTK"});
+  auto output = root.section("output", "what the run writes");
+  p.write_vtk = output.get<bool>("vtk", true, {"", "write velocity and pressure as VTK"});
+  p.checkpoint_interval =
+      output.get<int>("checkpoint_interval", 0,
+                      {"", "transient: time steps between checkpoints for --restart (0: none)",
+                       Bounds::closed(0, 1000000)});
   return p;
 }
 
@@ -144,6 +149,23 @@ class FlowProblem final : public run::Problem {
         fmt::format("navier_stokes: {}", parameters_.time.steady ? "steady" : "transient"));
   }
 
+  /// Transient runs continue from a checkpoint of an earlier run (written every
+  /// output.checkpoint_interval steps): the BDF history, the Windkessels, the step, and the
+  /// histories the benchmark needs. The reader must live until run() returns.
+  void restart_from(const run::CheckpointReader& checkpoint) override {
+    if (parameters_.time.steady)
+      throw InputError(fmt::format("--restart {}: a steady flow run has no checkpoints",
+                                   checkpoint.directory().string()));
+    const auto& state = checkpoint.state();
+    const std::string kind = state.contains("problem") ? state.at("problem").as_string() : "solid";
+    if (kind != "navier_stokes")
+      throw InputError(
+          fmt::format("--restart {}: a checkpoint of a '{}' run, this case is "
+                      "navier_stokes",
+                      checkpoint.directory().string(), kind));
+    restart_ = &checkpoint;
+  }
+
   void run(run::RunOutput& output) override {
     describe();
     model_.start(0.0);
@@ -165,7 +187,13 @@ class FlowProblem final : public run::Problem {
     } else {
       const int n_steps = p.time.n_steps();
       Progress progress(n_steps, p.time.end_time);
-      for (int step = 1; step <= n_steps; ++step) {
+      int first_step = 1;
+      if (restart_) {
+        read_checkpoint(*restart_);
+        first_step = model_.steps() + 1;
+        log::info("continuing after step {} (t = {:g} s)", model_.steps(), model_.time());
+      }
+      for (int step = first_step; step <= n_steps; ++step) {
         const double dt = std::min(p.time.time_step, p.time.end_time - model_.time());
         model_.begin_step(dt);
         const double time = model_.time();
@@ -184,6 +212,10 @@ class FlowProblem final : public run::Problem {
         progress.step(
             step, time,
             fmt::format("newton {}, ksp {}", report.iterations, report.linear_iterations));
+        if (p.checkpoint_interval > 0 && step % p.checkpoint_interval == 0) {
+          ScopedTimer timer(output.timers(), "checkpoint");
+          write_checkpoint(output);
+        }
       }
     }
     model_.write_windkessel_states(output);
@@ -201,6 +233,46 @@ class FlowProblem final : public run::Problem {
   }
 
  private:
+  /// The model's history and the benchmark histories into output/checkpoint.
+  void write_checkpoint(run::RunOutput& output) const {
+    run::CheckpointWriter writer(comm_, output.directory() / "checkpoint");
+    auto& state = writer.state();
+    state["problem"] = "navier_stokes";
+    model_.write_checkpoint(writer);
+    auto& histories = state["histories"];
+    histories["outlet_time"] = io::Json::array_of(history_time_);
+    histories["outlet_flow"] = io::Json::array_of(history_flow_);
+    histories["outlet_pressure"] = io::Json::array_of(history_pressure_);
+    histories["body_time"] = io::Json::array_of(history_body_time_);
+    histories["drag"] = io::Json::array_of(history_drag_);
+    histories["lift"] = io::Json::array_of(history_lift_);
+    writer.commit();
+  }
+
+  void read_checkpoint(const run::CheckpointReader& reader) {
+    model_.read_checkpoint(reader);
+    const auto& histories = reader.state().at("histories");
+    const auto doubles = [&](const char* key) {
+      std::vector<double> values;
+      for (const auto& value : histories.at(key).as_array()) values.push_back(value.as_double());
+      return values;
+    };
+    history_time_ = doubles("outlet_time");
+    history_flow_ = doubles("outlet_flow");
+    history_pressure_ = doubles("outlet_pressure");
+    history_body_time_ = doubles("body_time");
+    history_drag_ = doubles("drag");
+    history_lift_ = doubles("lift");
+    const bool outlet_history = history_time_.size() == static_cast<std::size_t>(model_.steps());
+    if ((benchmark_outlet_ >= 0 && !outlet_history) ||
+        (benchmark_outlet_ < 0 && !history_time_.empty()) ||
+        (body_tag_ < 0 && !history_body_time_.empty()))
+      throw InputError(fmt::format(
+          "--restart {}: the checkpoint's benchmark histories are not those of this case's "
+          "benchmark.type {}",
+          reader.directory().string(), parameters_.benchmark.type));
+  }
+
   /// One row of series.csv: iterations, the body's force coefficients, the flows.
   void record_step(run::RunOutput& output, double time, const NewtonReport& report) {
     auto& series = output.series();
@@ -467,6 +539,7 @@ class FlowProblem final : public run::Problem {
   /// Transient body forces from benchmark.statistics_from on: times, drag and lift (the
   /// benchmark's coefficients or forces).
   std::vector<double> history_body_time_, history_drag_, history_lift_;
+  const run::CheckpointReader* restart_ = nullptr;
 };
 
 }  // namespace

@@ -376,6 +376,57 @@ void FluidModel::restore_step() {
   time_ = committed_time_;
 }
 
+void FluidModel::write_checkpoint(run::CheckpointWriter& writer) const {
+  const int n = mesh_.dim + 1;
+  writer.add_vertex_field("fluid_u", mesh_, previous_, n);
+  writer.add_vertex_field("fluid_u_before", mesh_, before_, n);
+  auto& state = writer.state()["fluid"];
+  state["steps"] = steps_;
+  state["time"] = committed_time_;
+  state["last_step"] = last_step_;
+  auto& windkessels = state["windkessels"] = io::Json::object();
+  for (std::size_t k = 0; k < windkessels_.size(); ++k)
+    if (windkessels_[k])
+      windkessels[parameters_.outlets[k].group] = io::Json::array_of(windkessels_[k]->state());
+}
+
+void FluidModel::read_checkpoint(const run::CheckpointReader& reader) {
+  const auto folder = reader.directory().string();
+  const auto& checkpoint = reader.state();
+  if (!checkpoint.contains("fluid") || !checkpoint.at("fluid").is_object())
+    throw InputError(fmt::format("{}: the checkpoint holds no fluid state", folder));
+  const auto& state = checkpoint.at("fluid");
+  const int n = mesh_.dim + 1;
+  reader.read_vertex_field("fluid_u", mesh_, previous_, n);
+  reader.read_vertex_field("fluid_u_before", mesh_, before_, n);
+  COAPT_PETSC_CHECK(VecCopy(previous_, fluid_->state()));
+  fem::update_ghosts(fluid_->state());
+  steps_ = static_cast<int>(state.at("steps").as_int());
+  time_ = committed_time_ = state.at("time").as_double();
+  last_step_ = state.at("last_step").as_double();
+  const auto& windkessels = state.at("windkessels");
+  std::size_t restored = 0;
+  for (std::size_t k = 0; k < windkessels_.size(); ++k) {
+    if (!windkessels_[k]) continue;
+    const auto& group = parameters_.outlets[k].group;
+    if (!windkessels.contains(group))
+      throw InputError(
+          fmt::format("{}: the checkpoint has no Windkessel state for outlet '{}'", folder, group));
+    std::vector<double> values;
+    for (const auto& value : windkessels.at(group).as_array()) values.push_back(value.as_double());
+    try {
+      windkessels_[k]->restore(values);
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("{}: outlet '{}': {}", folder, group, e.what()));
+    }
+    ++restored;
+  }
+  if (restored != windkessels.size())
+    throw InputError(fmt::format(
+        "{}: the checkpoint has {} Windkessel state(s), the case {} Windkessel outlet(s)", folder,
+        windkessels.size(), restored));
+}
+
 void FluidModel::set_velocity_constraint(std::span<const int> vertices,
                                          std::span<const double> velocities) {
   fluid_->set_velocity_constraint(vertices, velocities);

@@ -36,6 +36,7 @@
 #include "coapt/mesh/mesh.hpp"
 #include "coapt/mesh/mesh_input.hpp"
 #include "coapt/mesh/quality.hpp"
+#include "coapt/run/checkpoint.hpp"
 #include "coapt/run/run_output.hpp"
 
 namespace coapt::fluid {
@@ -164,6 +165,15 @@ class FluidModel {
   void commit_step();
   /// Drops the trial state: state ← uⁿ, time ← tⁿ, Windkessels untouched.
   void restore_step();
+
+  /// Adds the committed history to a checkpoint: fields fluid_u (uⁿ) and fluid_u_before
+  /// (uⁿ⁻¹), and under state["fluid"] the steps, tⁿ, the last step size (the variable-step
+  /// BDF2 weights) and each Windkessel's state by outlet group.
+  void write_checkpoint(run::CheckpointWriter& writer) const;
+  /// After start(): takes that history back (state ← uⁿ), so that the next begin_step
+  /// continues as the run that wrote it did. InputError naming the checkpoint folder when it
+  /// is of another mesh or its Windkessels are not this case's outlets.
+  void read_checkpoint(const run::CheckpointReader& reader);
 
   /// Constrains the velocity at owned local vertices (vertices.size() × dim velocities, row
   /// major) [m/s] for the following solves (NavierStokes::set_velocity_constraint).

@@ -84,6 +84,11 @@ class SolidProblem final : public run::Problem {
     if (!parameters().time.dynamic)
       throw InputError(fmt::format("--restart {}: a quasi-static solid run has no checkpoints",
                                    checkpoint.directory().string()));
+    const auto& state = checkpoint.state();
+    if (state.contains("problem") && state.at("problem").as_string() != "solid")
+      throw InputError(fmt::format("--restart {}: a checkpoint of a '{}' run, this case is solid",
+                                   checkpoint.directory().string(),
+                                   state.at("problem").as_string()));
     restart_ = &checkpoint;
   }
 
@@ -323,6 +328,7 @@ class SolidProblem final : public run::Problem {
     int first_step = 1;
     if (restart_) {
       solid_.read_checkpoint(*restart_);
+      if (contact_) contact_->read_checkpoint(*restart_, "contact_");
       const auto& state = restart_->state();
       const auto doubles = [](const io::Json& array) {
         std::vector<double> values;
@@ -360,6 +366,7 @@ class SolidProblem final : public run::Problem {
       ScopedTimer timer(output.timers(), "checkpoint");
       run::CheckpointWriter writer(solid_.comm(), output.directory() / "checkpoint");
       auto& state = writer.state();
+      state["problem"] = "solid";
       state["step"] = step;
       state["time"] = t;
       state["initial_energy"] = initial_energy;
@@ -376,6 +383,7 @@ class SolidProblem final : public run::Problem {
         state["impact_energy"] = io::Json::array_of(impact_energy_);
       }
       solid_.write_checkpoint(writer);
+      if (contact_) contact_->write_checkpoint(writer, "contact_");
       writer.commit();
     };
 

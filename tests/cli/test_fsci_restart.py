@@ -1,0 +1,127 @@
+#!/usr/bin/python3
+"""Checkpoint and restart of the immersed coupling (`coapt run CASE --restart DIR`,
+coupling/fsci_problem.cpp write_checkpoint), on the 2D valve (cases/valve2d.yaml, level 0,
+pressure reversed from the start as in test_fsci_valve.py, 6 steps of 2 ms): leaflets by
+contact-stabilized Newmark with mortar contact, IQN-ILS reusing the last 4 steps' columns.
+
+- 3 steps writing a checkpoint at step 3, restarted to step 6 on the same 2 ranks, gives the
+  rows of steps 4..6 of series.csv (forces, coupling iterations and changes, opening, contact,
+  flows) and the summary's benchmark bit for bit as the run of 6 steps straight through: the
+  fluid's BDF2 history, the leaflets' Newmark state, the applied force that starts a step, the
+  constrained fluid nodes, the contact active set and the IQN-ILS columns all come back;
+- restarted on 1 rank (another partition), step 6 agrees to 1e-5 relative in the opening and
+  the inlet flow (the coupling stops at a relative change of 1e-3, so its iterates differ by
+  round-off from the 2-rank run's);
+- a rigid body translating through the fluid (cases/dfg/2d1_immersed.yaml made transient, the
+  cylinder moving at 0.1 m/s, 4 steps of 0.05 s; the constrained set changes every step):
+  2 + 2 steps on 1 rank give steps 3..4 and the benchmark bit for bit (the body's position
+  comes back from the checkpoint);
+- a checkpoint of a flow run and a checkpoint with other solids are refused with one error
+  line naming the folder, exit 2.
+The fluid and the solid are solved by PETSc's own LU of the gathered matrix (ksp_type
+preonly, pc_type redundant; test_fluid_restart.py): the default MUMPS LU is not bitwise
+reproducible on 2 ranks (two identical runs differ by ~1e-15 relative), so no restart could
+be."""
+
+import csv
+
+from cli_common import Runner, parse_arguments, read_json
+
+VALVE = ["--set", "output.vtk=false", "--set", "fluid.outlets[0].waveform.times=[0,0.03,1]",
+         "--set", "fluid.outlets[0].waveform.values=[0,-1.5,-1.5]",
+         "--set", "output.checkpoint_interval=3"]
+DETERMINISTIC = ["--", "-fluid_ksp_type", "preonly", "-fluid_pc_type", "redundant",
+                 "-fluid_redundant_pc_type", "lu", "-solid_pc_type", "redundant",
+                 "-solid_redundant_pc_type", "lu"]
+
+
+def rows(path):
+    with open(path) as f:
+        return list(csv.DictReader(f))
+
+
+def main():
+    arguments = parse_arguments()
+    runner = Runner(arguments)
+    work = runner.work
+    case = runner.source / "cases" / "valve2d.yaml"
+
+    def run(output, end_time, *extra, ranks=2):
+        return runner.run("run", case, "--output", work / output, "--set",
+                          f"time.end_time={end_time}", *VALVE, *extra, *DETERMINISTIC,
+                          ranks=ranks)
+
+    runs = {"straight": run("straight", 0.012), "first": run("first", 0.006)}
+    runs["again"] = run("again", 0.012, "--restart", work / "first")
+    for name, result in runs.items():
+        runner.expect(result.returncode == 0, f"valve {name} run succeeds",
+                      result.stdout[-3000:] + result.stderr)
+    if runner.failures:
+        runner.finish()
+    state = read_json(work / "first" / "checkpoint" / "state.json")["state"]
+    print(f"checkpoint at step {state['step']}: IQN-ILS columns per kept step {state['iqn_columns']}, "
+          f"constrained fluid nodes restored, complementarity constant "
+          f"{state['solid0_contact']['complementarity_constant']:.4g}")
+    runner.expect(sum(state["iqn_columns"]) > 0, "the checkpoint holds IQN-ILS columns to reuse")
+    reference = rows(work / "straight" / "series.csv")
+    again = rows(work / "again" / "series.csv")
+    runner.expect(len(reference) == 6 and again == reference[3:],
+                  "same ranks: steps 4..6 bit for bit as the straight run",
+                  f"{len(again)} rows restarted, {len(reference)} straight\n"
+                  + "\n".join(f"{k}: {a[k]} vs {b[k]}" for a, b in zip(again, reference[3:])
+                              for k in a if a[k] != b[k]))
+    a = read_json(work / "straight" / "summary.json")["benchmark"]
+    b = read_json(work / "again" / "summary.json")["benchmark"]
+    runner.expect(a == b, "same ranks: the benchmark bit for bit", f"{a}\n{b}")
+
+    result = run("again1", 0.012, "--restart", work / "first", ranks=1)
+    runner.expect(result.returncode == 0, "restart on 1 rank succeeds",
+                  result.stdout[-3000:] + result.stderr)
+    if result.returncode == 0:
+        last, expected = rows(work / "again1" / "series.csv")[-1], reference[-1]
+        worst = max(abs(float(last[k]) / float(expected[k]) - 1)
+                    for k in ("opening_leaflets", "outlet_flow_inlet"))
+        runner.expect(last["time"] == expected["time"] and worst < 1e-5,
+                      f"restart on 1 rank: step 6 agrees to 1e-5 (largest relative difference "
+                      f"{worst:.2e})")
+
+    rigid = runner.source / "cases" / "dfg" / "2d1_immersed.yaml"
+    moving = ["--set", "output.vtk=false", "--set", "time.steady=false", "--set", "time.step=0.05",
+              "--set", "solids[0].velocity=[0.1, 0]", "--set", "output.checkpoint_interval=2"]
+
+    def run_rigid(output, end_time, *extra):
+        return runner.run("run", rigid, "--output", work / output, "--set",
+                          f"time.end_time={end_time}", *moving, *extra, ranks=1)
+
+    results = [run_rigid("rigid", 0.2), run_rigid("rigid-first", 0.1)]
+    results.append(run_rigid("rigid-again", 0.2, "--restart", work / "rigid-first"))
+    runner.expect(all(result.returncode == 0 for result in results), "moving rigid body runs succeed",
+                  "\n".join(result.stderr[-2000:] for result in results))
+    if all(result.returncode == 0 for result in results):
+        reference = rows(work / "rigid" / "series.csv")
+        again = rows(work / "rigid-again" / "series.csv")
+        runner.expect(len(again) == 2 and again == reference[-2:],
+                      "moving rigid body: steps 3..4 bit for bit as the straight run")
+        runner.expect(reference[-1]["constrained_cylinder"] != reference[-3]["constrained_cylinder"],
+                      "moving rigid body: the constrained set changed over the restarted steps")
+        runner.expect(read_json(work / "rigid" / "summary.json")["benchmark"] ==
+                      read_json(work / "rigid-again" / "summary.json")["benchmark"],
+                      "moving rigid body: the benchmark bit for bit")
+
+    def refused(result, what, needle):
+        errors = [line for line in result.stderr.splitlines() if "error:" in line]
+        runner.expect(result.returncode == 2 and len(errors) == 1 and needle in errors[0],
+                      f"refused: {what}", result.stdout + result.stderr)
+
+    flow = runner.run("run", runner.source / "cases" / "dfg" / "2d2.yaml", "--output", work / "flow",
+                      "--set", "time.end_time=0.01", "--set", "time.step=0.01", "--set",
+                      "output.vtk=false", "--set", "output.checkpoint_interval=1", ranks=1)
+    runner.expect(flow.returncode == 0, "a flow run writing a checkpoint succeeds", flow.stderr)
+    refused(run("bad1", 0.012, "--restart", work / "flow"), "a checkpoint of a flow run", "flow")
+    refused(run("bad2", 0.012, "--set", "solids[0].name=valve", "--set", "benchmark.solid=valve",
+                "--restart", work / "first"), "a checkpoint with other solids", "first")
+    runner.finish()
+
+
+if __name__ == "__main__":
+    main()
