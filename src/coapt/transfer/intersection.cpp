@@ -131,12 +131,11 @@ Overlap<dim> find_overlap(const Simplex<dim>& a, const Simplex<dim>& b, Polytope
   }
 
   // 5. clip the unit simplex (S in its reference coordinates) by λ^L_j ≥ 0
-  std::array<Point<dim>, dim + 1> unit{};
-  for (int k = 0; k < dim; ++k) unit[k + 1][k] = 1.0;
-  if constexpr (dim == 2)
-    polytope.assign_triangle(unit);
-  else
-    polytope.assign_tetrahedron(unit);
+  if constexpr (dim == 2) {
+    polytope.assign_triangle({Point<2>{0.0, 0.0}, Point<2>{1.0, 0.0}, Point<2>{0.0, 1.0}});
+  } else {
+    polytope.assign_unit_tetrahedron();
+  }
   for (int j = 0; j <= dim; ++j) {
     if (!((cutting >> j) & 1u)) continue;
     HalfSpace<dim> plane;
