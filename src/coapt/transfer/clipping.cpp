@@ -381,9 +381,13 @@ void ConvexPolyhedron::for_each_fan_tetrahedron(Visit&& visit) const {
   const auto skip = [](int, int, int) {};
   for (int slot = 0; slot < 3; ++slot) walk(apex, slot, skip);
   for (int u = 1; u < n_vertices_; ++u) {
+    // A walk from `start` returns before it reaches `start` again, so the edges of `start`
+    // left to walk are known before the first one.
     const int start = in_use_[u];
-    for (int slot = 0; slot < 3; ++slot)
-      if (!((visited[start] >> slot) & 1u)) walk(start, slot, visit);
+    const unsigned todo = ~visited[start] & 7u;
+    if (todo & 1u) walk(start, 0, visit);
+    if (todo & 2u) walk(start, 1, visit);
+    if (todo & 4u) walk(start, 2, visit);
   }
 }
 
