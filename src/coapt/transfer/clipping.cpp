@@ -193,6 +193,12 @@ int ConvexPolygon::quadrature(QuadraturePoint<2>* points) const {
 // the geometry and every operation below is purely combinatorial once the vertices are
 // classified.
 //
+// Storage. A clip appends its new vertices to the buffer and leaves the clipped ones where
+// they are; the vertices in use are the list in_use_ of buffer slots (kept vertices in their
+// old order, then the new ones in creation order, which is the numbering vertex(v) and
+// neighbors(v) expose). Besides its neighbours, each vertex stores back_[v][k], the slot of v
+// in the list of neighbors_[v][k], so walking a face is a table look-up per step.
+//
 // Clip by {d(x) ≥ 0}. (1) Compute d at every vertex, snap |d| ≤ tol to exactly 0. No vertex
 // strictly outside: unchanged. No vertex strictly inside: empty (zero volume is left).
 // (2) For every edge (v kept, w clipped, i.e. d(v) ≥ 0 > d(w)) add a vertex n at
@@ -200,7 +206,8 @@ int ConvexPolygon::quadrature(QuadraturePoint<2>* points) const {
 // make v point to n instead of w. (3) Link the new vertices: from each new vertex s, step to
 // its kept neighbour and walk along the face until the next new vertex e; then
 // neighbors(s)[2] = e and neighbors(e)[1] = s. This closes every cut face and builds the
-// cap face(s) on the plane with the right orientation. (4) Drop clipped vertices, renumber.
+// cap face(s) on the plane with the right orientation. (4) The kept and the new vertices
+// are the vertices in use; the clipped ones are no longer referenced.
 //
 // Invariants. The graph is 3-regular with a consistent rotation after every clip, for any
 // pattern of clipped vertices (step 3 pairs the two new vertices that bound each run of
@@ -210,9 +217,9 @@ int ConvexPolygon::quadrature(QuadraturePoint<2>* points) const {
 // point on a shared plane is classified the same way from both sides. No division by zero.
 //
 // Size bound. With V vertices (E = 3V/2 edges), a clip adds one vertex per (kept, clipped)
-// edge: at most 3·min(kept, clipped) ≤ 3V/2 new, so V' = kept + new ≤ 2V, and the buffer
-// holds V + new ≤ 5V/2 before compaction. From a tetrahedron: V ≤ 8, 16, 32, 64 after 1..4
-// clips, buffer ≤ 80 during the 4th. Geometrically tet ∩ tet has at most 8 faces and
+// edge: at most 3·min(kept, clipped) ≤ 3V/2 new, so V' = kept + new ≤ 2V: V ≤ 8, 16, 32, 64
+// after 1..4 clips of a tetrahedron, and the buffer, which keeps the clipped vertices, holds
+// at most 4 + 6 + 12 + 24 + 48 = 94 vertices. Geometrically tet ∩ tet has at most 8 faces and
 // 2·8 − 4 = 12 vertices; the larger bound covers coincident vertices and round-off.
 //
 // Moments and quadrature: each face cycle (f_0, f_1, ..., f_m) not through vertex 0 is cut
@@ -221,6 +228,10 @@ int ConvexPolygon::quadrature(QuadraturePoint<2>* points) const {
 // so all these volumes are ≥ 0 up to round-off. At most Σ_faces (m_f − 2) = 2V − 4
 // tetrahedra, minus those of the three faces through vertex 0.
 // ================================================================================================
+
+namespace {
+constexpr std::array<int, 3> kNextSlot{1, 2, 0};
+}  // namespace
 
 void ConvexPolyhedron::assign_tetrahedron(const std::array<Point<3>, 4>& vertices) {
   const Point<3> e1{vertices[1][0] - vertices[0][0], vertices[1][1] - vertices[0][1],
@@ -234,124 +245,167 @@ void ConvexPolyhedron::assign_tetrahedron(const std::array<Point<3>, 4>& vertice
   positions_[1] = positive ? vertices[1] : vertices[2];
   positions_[2] = positive ? vertices[2] : vertices[1];
   positions_[3] = vertices[3];
-  // Counter-clockwise neighbours seen from outside for a positively oriented tetrahedron.
+  // Counter-clockwise neighbours seen from outside for a positively oriented tetrahedron,
+  // and the slot of each vertex in its neighbours' lists.
   neighbors_[0] = {1, 3, 2};
   neighbors_[1] = {2, 3, 0};
   neighbors_[2] = {0, 3, 1};
   neighbors_[3] = {1, 2, 0};
+  back_[0] = {2, 2, 0};
+  back_[1] = {2, 0, 0};
+  back_[2] = {2, 1, 0};
+  back_[3] = {1, 1, 1};
+  in_use_[0] = 0;
+  in_use_[1] = 1;
+  in_use_[2] = 2;
+  in_use_[3] = 3;
   n_vertices_ = 4;
+  n_made_ = 4;
   n_clips_ = 0;
+}
+
+void ConvexPolyhedron::assign_unit_tetrahedron() {
+  assign_tetrahedron({Point<3>{0.0, 0.0, 0.0}, Point<3>{1.0, 0.0, 0.0}, Point<3>{0.0, 1.0, 0.0},
+                      Point<3>{0.0, 0.0, 1.0}});
+}
+
+std::array<int, 3> ConvexPolyhedron::neighbors(int v) const {
+  std::array<int, 3> numbers{};
+  for (int k = 0; k < 3; ++k) {
+    const int slot = neighbors_[in_use_[v]][k];
+    int number = 0;
+    while (number < n_vertices_ && in_use_[number] != slot) ++number;
+    numbers[k] = number < n_vertices_ ? number : -1;
+  }
+  return numbers;
 }
 
 bool ConvexPolyhedron::clip(const HalfSpace<3>& half_space, double tolerance) {
   if (n_vertices_ == 0) return false;
-  const Side side = classify<3>(half_space, positions_, n_vertices_, tolerance, distances_.data());
-  if (side == Side::inside) return true;
-  if (side == Side::outside) {
+  // (1) classify (as classify() above, through the list of vertices in use)
+  bool any_inside = false, any_outside = false;
+  for (int u = 0; u < n_vertices_; ++u) {
+    const int v = in_use_[u];
+    double d = half_space.distance(positions_[v]);
+    if (std::fabs(d) <= tolerance) d = 0.0;
+    distances_[v] = d;
+    any_inside |= d > 0.0;
+    any_outside |= d < 0.0;
+  }
+  if (!any_outside) return true;
+  if (!any_inside) {
     n_vertices_ = 0;
     return false;
   }
   COAPT_ASSERT(n_clips_ < max_clips, "a tetrahedron is clipped by at most 4 half-spaces");
 
-  // (2) one new vertex on every (kept, clipped) edge
-  const int first_new = n_vertices_;
-  int n = n_vertices_;
-  for (int v = 0; v < first_new; ++v) {
-    if (distances_[v] < 0.0) continue;
+  // (2) one new vertex on every (kept, clipped) edge; the kept vertices stay in use, in order
+  const int first_new = n_made_;
+  int n = n_made_;
+  int kept = 0;
+  for (int u = 0; u < n_vertices_; ++u) {
+    const int v = in_use_[u];
+    const double dv = distances_[v];
+    if (dv < 0.0) continue;
+    in_use_[kept++] = v;
     for (int k = 0; k < 3; ++k) {
       const int w = neighbors_[v][k];
-      if (distances_[w] >= 0.0) continue;
+      const double dw = distances_[w];
+      if (dw >= 0.0) continue;
       COAPT_ASSERT(n < buffer_size, "polyhedron clipping exceeded its size bound");
-      const double t = distances_[v] / (distances_[v] - distances_[w]);
+      const double t = dv / (dv - dw);
       const Point<3>& x = positions_[v];
       const Point<3>& y = positions_[w];
       positions_[n] = {x[0] + t * (y[0] - x[0]), x[1] + t * (y[1] - x[1]),
                        x[2] + t * (y[2] - x[2])};
-      neighbors_[n] = {v, -1, -1};
+      neighbors_[n][0] = v;
+      back_[n][0] = k;
       distances_[n] = 0.0;
       neighbors_[v][k] = n;
+      back_[v][k] = 0;
       ++n;
     }
   }
+  COAPT_ASSERT(kept + n - first_new <= max_vertices, "polyhedron clipping exceeded its size bound");
 
   // (3) link consecutive new vertices along each face
   for (int start = first_new; start < n; ++start) {
     int current = start;
-    int next = neighbors_[start][0];
+    int slot = 0;
     int steps = 0;
     do {
-      int back = 0;
-      while (back < 3 && neighbors_[next][back] != current) ++back;
-      COAPT_ASSERT(back < 3 && ++steps <= n, "polyhedron graph is inconsistent");
+      const int next = neighbors_[current][slot];
+      slot = kNextSlot[back_[current][slot]];
       current = next;
-      next = neighbors_[current][(back + 1) % 3];
+      COAPT_ASSERT(++steps <= n, "polyhedron graph is inconsistent");
     } while (current < first_new);
     neighbors_[start][2] = current;
+    back_[start][2] = 1;
     neighbors_[current][1] = start;
+    back_[current][1] = 2;
   }
 
-  // (4) compact: keep d ≥ 0 (the new vertices have d = 0), renumber the neighbours
-  std::array<int, buffer_size> renumber;
-  int kept = 0;
-  for (int v = 0; v < n; ++v) {
-    if (distances_[v] < 0.0) continue;
-    positions_[kept] = positions_[v];
-    neighbors_[kept] = neighbors_[v];
-    renumber[v] = kept++;
-  }
-  for (int v = 0; v < kept; ++v)
-    for (int k = 0; k < 3; ++k) neighbors_[v][k] = renumber[neighbors_[v][k]];
+  // (4) the new vertices join the kept ones
+  for (int v = first_new; v < n; ++v) in_use_[kept++] = v;
   n_vertices_ = kept;
+  n_made_ = n;
   ++n_clips_;
   return true;
 }
 
-// Calls visit(a, b, c) for every fan tetrahedron (apex, apex + a, apex + b, apex + c),
-// positively oriented, with a, b, c relative to the apex = vertex 0. The faces through the
-// apex would give flat tetrahedra and are skipped.
+// Calls visit(a, b, c) with the buffer slots of every fan tetrahedron (apex, a, b, c),
+// positively oriented, apex = vertex 0. The faces through the apex would give flat
+// tetrahedra and are skipped.
 template <class Visit>
 void ConvexPolyhedron::for_each_fan_tetrahedron(Visit&& visit) const {
-  const Point<3> apex = positions_[0];
-  std::array<Point<3>, buffer_size> q;
-  for (int v = 0; v < n_vertices_; ++v)
-    for (int c = 0; c < 3; ++c) q[v][c] = positions_[v][c] - apex[c];
-  std::array<std::array<bool, 3>, buffer_size> visited{};
+  const int apex = in_use_[0];
+  std::array<unsigned char, buffer_size> visited;  // bit k: the edge (v, neighbors(v)[k]) walked
+  for (int u = 0; u < n_vertices_; ++u) visited[in_use_[u]] = 0;
   // Walks the face to the left of the directed edge (start, neighbors(start)[slot]),
   // marking its edges, and gives its fan triangles (start, next, current) to `triangle`.
   const auto walk = [&](int start, int slot, auto&& triangle) {
-    visited[start][slot] = true;
-    int previous = start;
+    visited[start] |= static_cast<unsigned char>(1u << slot);
     int current = neighbors_[start][slot];
+    int back = back_[start][slot];
     for (int steps = 0;; ++steps) {
-      int back = 0;
-      while (back < 3 && neighbors_[current][back] != previous) ++back;
-      COAPT_ASSERT(back < 3 && steps < n_vertices_, "polyhedron graph is inconsistent");
-      const int out = back == 2 ? 0 : back + 1;
-      visited[current][out] = true;
+      COAPT_ASSERT(steps < n_vertices_, "polyhedron graph is inconsistent");
+      const int out = kNextSlot[back];
+      visited[current] |= static_cast<unsigned char>(1u << out);
       const int next = neighbors_[current][out];
       if (next == start) return;
       triangle(start, next, current);  // the walk is clockwise from outside
-      previous = current;
+      back = back_[current][out];
       current = next;
     }
   };
   const auto skip = [](int, int, int) {};
-  for (int slot = 0; slot < 3; ++slot) walk(0, slot, skip);
-  const auto tetrahedron = [&](int a, int b, int c) { visit(q[a], q[b], q[c]); };
-  for (int start = 1; start < n_vertices_; ++start)
-    for (int slot = 0; slot < 3; ++slot)
-      if (!visited[start][slot]) walk(start, slot, tetrahedron);
+  for (int slot = 0; slot < 3; ++slot) walk(apex, slot, skip);
+  for (int u = 1; u < n_vertices_; ++u) {
+    // A walk from `start` returns before it reaches `start` again, so the edges of `start`
+    // left to walk are known before the first one.
+    const int start = in_use_[u];
+    const unsigned todo = ~visited[start] & 7u;
+    if (todo & 1u) walk(start, 0, visit);
+    if (todo & 2u) walk(start, 1, visit);
+    if (todo & 4u) walk(start, 2, visit);
+  }
 }
 
 Moments<3> ConvexPolyhedron::moments() const {
   if (n_vertices_ < 4) return {};
-  const Point<3> center = positions_[0];
+  const Point<3> center = positions_[in_use_[0]];
   // Tetrahedron (0, a, b, c): |T| = a · (b × c) / 6, ∫x = |T| s / 4,
-  // ∫x xᵀ = |T| / 20 (a aᵀ + b bᵀ + c cᵀ + s sᵀ), s = a + b + c.
+  // ∫x xᵀ = |T| / 20 (a aᵀ + b bᵀ + c cᵀ + s sᵀ), s = a + b + c, positions relative to the apex.
+  std::array<Point<3>, buffer_size> q;
+  for (int u = 0; u < n_vertices_; ++u)
+    for (int c = 0; c < 3; ++c) q[in_use_[u]][c] = positions_[in_use_[u]][c] - center[c];
   double volume = 0.0;
   Point<3> first{};
   std::array<double, 6> s{};  // xx, yy, zz, xy, xz, yz
-  for_each_fan_tetrahedron([&](const Point<3>& a, const Point<3>& b, const Point<3>& c) {
+  for_each_fan_tetrahedron([&](int ia, int ib, int ic) {
+    const Point<3>& a = q[ia];
+    const Point<3>& b = q[ib];
+    const Point<3>& c = q[ic];
     const double t = dot(a, cross(b, c)) / 6.0;
     const Point<3> sum{a[0] + b[0] + c[0], a[1] + b[1] + c[1], a[2] + b[2] + c[2]};
     volume += t;
@@ -375,9 +429,15 @@ Moments<3> ConvexPolyhedron::moments() const {
 
 int ConvexPolyhedron::quadrature(QuadraturePoint<3>* points) const {
   if (n_vertices_ < 4) return 0;
-  const Point<3> center = positions_[0];
+  const Point<3> center = positions_[in_use_[0]];
+  std::array<Point<3>, buffer_size> q;
+  for (int u = 0; u < n_vertices_; ++u)
+    for (int c = 0; c < 3; ++c) q[in_use_[u]][c] = positions_[in_use_[u]][c] - center[c];
   int n = 0;
-  for_each_fan_tetrahedron([&](const Point<3>& a, const Point<3>& b, const Point<3>& c) {
+  for_each_fan_tetrahedron([&](int ia, int ib, int ic) {
+    const Point<3>& a = q[ia];
+    const Point<3>& b = q[ib];
+    const Point<3>& c = q[ic];
     const double volume = dot(a, cross(b, c)) / 6.0;
     if (!(volume > 0.0)) return;
     // vertex k of (0, a, b, c) gets α x_k + β (sum of the others) = β s + (α − β) x_k

@@ -64,24 +64,29 @@ class ConvexPolygon {
 };
 
 /// A convex polyhedron as a 3-regular vertex graph (each vertex stores its three
-/// neighbours counter-clockwise seen from outside), made from a tetrahedron and clipped by
-/// at most four half-spaces.
+/// neighbours counter-clockwise seen from outside, and where it appears in each neighbour's
+/// list), made from a tetrahedron and clipped by at most four half-spaces. Clipped vertices
+/// stay in the buffer, unused: the vertices in use are a list of buffer slots, so a clip moves
+/// no vertex and renumbers no neighbour.
 class ConvexPolyhedron {
  public:
   static constexpr int max_clips = 4;
   static constexpr int max_vertices = 64;  ///< after 4 clips of a tetrahedron (see clipping.cpp)
-  static constexpr int buffer_size = 80;   ///< during the 4th clip, before compaction
+  static constexpr int buffer_size = 96;   ///< vertices ever made by 4 clips (see clipping.cpp)
   static constexpr int max_tetrahedra = 2 * max_vertices - 4;  ///< fan decomposition
   static constexpr int max_quadrature_points = 4 * max_tetrahedra;
 
   /// Starts from a tetrahedron (either orientation).
   void assign_tetrahedron(const std::array<Point<3>, 4>& vertices);
+  /// Starts from the unit tetrahedron (0, e_1, e_2, e_3).
+  void assign_unit_tetrahedron();
   /// Keeps the part with distance ≥ 0; |distance| ≤ tolerance counts as on the plane.
   /// Returns false when nothing of positive volume is left (the polyhedron is then empty).
   bool clip(const HalfSpace<3>& half_space, double tolerance);
+  /// Number of vertices; vertex(v) and neighbors(v) number them 0 .. size() − 1.
   int size() const { return n_vertices_; }
-  const Point<3>& vertex(int v) const { return positions_[v]; }
-  const std::array<int, 3>& neighbors(int v) const { return neighbors_[v]; }
+  const Point<3>& vertex(int v) const { return positions_[in_use_[v]]; }
+  std::array<int, 3> neighbors(int v) const;
   /// Volume, centroid and central second moment (exact, by the fan from vertex 0).
   Moments<3> moments() const;
   /// Degree-2 rule on the same fan (4 points per tetrahedron of positive volume) into
@@ -92,10 +97,14 @@ class ConvexPolyhedron {
   template <class Visit>
   void for_each_fan_tetrahedron(Visit&& visit) const;
 
-  int n_vertices_ = 0;
+  int n_vertices_ = 0;  // in use
+  int n_made_ = 0;      // buffer slots used since assign_*
   int n_clips_ = 0;
+  std::array<int, max_vertices> in_use_{};  // buffer slots of the vertices, in creation order
   std::array<Point<3>, buffer_size> positions_{};
   std::array<std::array<int, 3>, buffer_size> neighbors_{};
+  // back_[v][k]: the slot of v in the neighbour list of neighbors_[v][k]
+  std::array<std::array<int, 3>, buffer_size> back_{};
   std::array<double, buffer_size> distances_{};  // scratch for clip()
 };
 

@@ -5,7 +5,6 @@
 #include "coapt/transfer/intersection.hpp"
 
 #include <cmath>
-#include <limits>
 
 namespace coapt::transfer {
 
@@ -22,7 +21,10 @@ namespace coapt::transfer {
 //     L ⊂ S and A∩B = L.
 //  5. Otherwise clip S in its own reference coordinates ξ (x = s_0 + J ξ, S = the unit
 //     simplex) by the half-spaces {λ^L_j ≥ 0} of the cutting planes only, where
-//     λ^L_j(ξ) = β_j0 + Σ_k (β_jk − β_j0) ξ_k is known from step 3 (clipping.cpp).
+//     λ^L_j(ξ) = β_j0 + Σ_k (β_jk − β_j0) ξ_k is known from step 3 (clipping.cpp). The
+//     planes that cut off more vertices of S (β_jk < −tol) go first, so that the later
+//     clips work on a small polytope (the result does not depend on the order, up to
+//     round-off).
 //  6. Moments of the clipped polytope in ξ (measure V_ξ, centroid ξ̄, central second
 //     moment C_ξ); with u = (1 − Σξ, ξ) = λ^S and its covariance C_u,
 //       ∫ λ^S_i λ^L_j = d!|S| Σ_k (V_ξ ū_i ū_k + C_u,ik) β_jk,
@@ -69,6 +71,32 @@ struct Overlap {
   NodalMatrix<dim> gamma;               ///< γ_ik = λ^S_i(l_k) (set for large_inside and clipped)
 };
 
+// table[j][k] = λ^T_j(p_k) for the vertices p_k of P, as T.barycentric(j, p_k) (same
+// operations in the same order), with P's coordinates transposed first so that the loop over
+// the vertices is a vector operation; lowest[j] and highest[j] are the extremes of row j.
+template <int dim>
+void barycentric_table(const Simplex<dim>& t, const Simplex<dim>& p, NodalMatrix<dim>& table,
+                       NodalVector<dim>& lowest, NodalVector<dim>& highest) {
+  std::array<NodalVector<dim>, dim> coordinates;  // [c][k]: coordinate c of p_k
+  for (int k = 0; k <= dim; ++k)
+    for (int c = 0; c < dim; ++c) coordinates[c][k] = p.vertices[k][c];
+  for (int j = 0; j <= dim; ++j) {
+    const Point<dim>& anchor = t.vertices[Simplex<dim>::anchor(j)];
+    const Point<dim>& gradient = t.gradients[j];
+    NodalVector<dim> value{};
+    for (int c = 0; c < dim; ++c)
+      for (int k = 0; k <= dim; ++k) value[k] += gradient[c] * (coordinates[c][k] - anchor[c]);
+    table[j] = value;
+  }
+  // extremes over k for all j at once (not fmin/fmax: those are library calls here)
+  for (int j = 0; j <= dim; ++j) lowest[j] = highest[j] = table[j][0];
+  for (int k = 1; k <= dim; ++k)
+    for (int j = 0; j <= dim; ++j) {
+      lowest[j] = table[j][k] < lowest[j] ? table[j][k] : lowest[j];
+      highest[j] = table[j][k] > highest[j] ? table[j][k] : highest[j];
+    }
+}
+
 template <int dim>
 Overlap<dim> find_overlap(const Simplex<dim>& a, const Simplex<dim>& b, Polytope<dim>& polytope) {
   using Kind = typename Overlap<dim>::Kind;
@@ -87,17 +115,12 @@ Overlap<dim> find_overlap(const Simplex<dim>& a, const Simplex<dim>& b, Polytope
   overlap.large = &large;
 
   // 3. faces of L against the vertices of S
+  NodalVector<dim> lowest, highest;
+  barycentric_table(large, small, overlap.beta, lowest, highest);
   unsigned cutting = 0;
   for (int j = 0; j <= dim; ++j) {
-    double lowest = std::numeric_limits<double>::infinity(), highest = -lowest;
-    for (int k = 0; k <= dim; ++k) {
-      const double d = large.barycentric(j, small.vertices[k]);
-      overlap.beta[j][k] = d;
-      lowest = d < lowest ? d : lowest;  // not fmin/fmax: those are library calls here
-      highest = d > highest ? d : highest;
-    }
-    if (!(highest > tol)) return overlap;  // separating plane
-    if (lowest < -tol) cutting |= 1u << j;
+    if (!(highest[j] > tol)) return overlap;  // separating plane
+    if (lowest[j] < -tol) cutting |= 1u << j;
   }
   if (overlap.a_is_small) overlap.b_crossed = cutting;  // B = L
   if (cutting == 0) {
@@ -109,16 +132,10 @@ Overlap<dim> find_overlap(const Simplex<dim>& a, const Simplex<dim>& b, Polytope
   // 4. faces of S against the vertices of L
   bool large_inside = true;
   unsigned crossed = 0;  // faces of S crossed by L
+  barycentric_table(small, large, overlap.gamma, lowest, highest);
   for (int i = 0; i <= dim; ++i) {
-    double lowest = std::numeric_limits<double>::infinity(), highest = -lowest;
-    for (int k = 0; k <= dim; ++k) {
-      const double d = small.barycentric(i, large.vertices[k]);
-      overlap.gamma[i][k] = d;
-      lowest = d < lowest ? d : lowest;
-      highest = d > highest ? d : highest;
-    }
-    if (!(highest > tol)) return overlap;
-    if (lowest < -tol) {
+    if (!(highest[i] > tol)) return overlap;
+    if (lowest[i] < -tol) {
       large_inside = false;
       crossed |= 1u << i;
     }
@@ -131,14 +148,25 @@ Overlap<dim> find_overlap(const Simplex<dim>& a, const Simplex<dim>& b, Polytope
   }
 
   // 5. clip the unit simplex (S in its reference coordinates) by λ^L_j ≥ 0
-  std::array<Point<dim>, dim + 1> unit{};
-  for (int k = 0; k < dim; ++k) unit[k + 1][k] = 1.0;
-  if constexpr (dim == 2)
-    polytope.assign_triangle(unit);
-  else
-    polytope.assign_tetrahedron(unit);
+  if constexpr (dim == 2) {
+    polytope.assign_triangle({Point<2>{0.0, 0.0}, Point<2>{1.0, 0.0}, Point<2>{0.0, 1.0}});
+  } else {
+    polytope.assign_unit_tetrahedron();
+  }
+  // Cutting planes in the order of the number of vertices of S they cut off, most first
+  // (ties in face order): the polytope the later clips work on is then small.
+  std::array<int, dim + 1> order{}, cut_off{};
+  int n_planes = 0;
   for (int j = 0; j <= dim; ++j) {
     if (!((cutting >> j) & 1u)) continue;
+    for (int k = 0; k <= dim; ++k) cut_off[j] += overlap.beta[j][k] < -tol ? 1 : 0;
+    int position = n_planes++;
+    for (; position > 0 && cut_off[order[position - 1]] < cut_off[j]; --position)
+      order[position] = order[position - 1];
+    order[position] = j;
+  }
+  for (int p = 0; p < n_planes; ++p) {
+    const int j = order[p];
     HalfSpace<dim> plane;
     plane.offset = overlap.beta[j][0];
     for (int k = 0; k < dim; ++k) plane.normal[k] = overlap.beta[j][k + 1] - overlap.beta[j][0];

@@ -341,7 +341,7 @@ TEST(TetrahedronIntersection, CutByAPlane) {
 TEST(IntersectionWorkspace, SizesAreFixed) {
   // The bounds the workspace is sized by (see clipping.cpp).
   static_assert(ConvexPolygon::capacity == 9);
-  static_assert(ConvexPolyhedron::max_vertices == 64 && ConvexPolyhedron::buffer_size == 80);
+  static_assert(ConvexPolyhedron::max_vertices == 64 && ConvexPolyhedron::buffer_size == 96);
   static_assert(IntersectionWorkspace<3>::max_quadrature_points == 496);
   SUCCEED() << "sizeof workspace: 2D " << sizeof(IntersectionWorkspace<2>) << " B, 3D "
             << sizeof(IntersectionWorkspace<3>) << " B";
