@@ -1,7 +1,8 @@
 // SolidModel as the coupled problems use it, on 1, 2 and 3 ranks: the extra nodal force
 // enters the residual like a load, a Newmark step repeated from the committed state (a
-// coupling iteration) gives the same trial state, and a body whose inertia density is offset
-// to zero (an immersed solid as dense as the fluid) steps quasi-statically.
+// coupling iteration) gives the same trial state, a body whose inertia density is offset
+// to zero (an immersed solid as dense as the fluid) steps quasi-statically, and a driver's
+// options (SolidModelOptions) make a case without time keys dynamic and refine its mesh.
 
 #include <gtest/gtest.h>
 #include <petscvec.h>
@@ -144,6 +145,30 @@ TEST(SolidModel, ZeroInertiaDensityStepsQuasiStatically) {
   EXPECT_LT(max_difference(reference.displacement(), solid.displacement()), 1e-10 * scale);
 
   EXPECT_THROW(solid.set_density_offset(1001), coapt::InputError);
+}
+
+TEST(SolidModel, DriverOptionsMakeItDynamicAndRefineItsMesh) {
+  // The immersed coupling's solid has no `time:` keys: driver_dynamic makes it step as the
+  // same case with time.scheme newmark does; extra_mesh_levels refines its mesh.
+  Output output("driver");
+  auto own = Document::from_string(
+      strip_case("gravity: [0, -0.5]\ntime: {scheme: newmark, step: 0.01, end_time: 1}\n"),
+      "own.yaml");
+  auto driven = Document::from_string(strip_case("gravity: [0, -0.5]\n"), "driven.yaml");
+  SolidModel reference(own.root(), kWorld);
+  SolidModel solid(driven.root(), kWorld, {0, "mesh.level", true});
+  EXPECT_TRUE(solid.parameters().time.dynamic);
+  for (auto* model : {&reference, &solid}) {
+    model->initialize_dynamics(output.output);
+    model->step(0.01, 0.01, output.output);
+  }
+  const double scale = max_norm(reference.displacement());
+  EXPECT_GT(scale, 1e-6);
+  EXPECT_LT(max_difference(reference.displacement(), solid.displacement()), 1e-12 * scale);
+
+  SolidModel refined(driven.root(), kWorld, {1, "mesh.level", false});
+  EXPECT_FALSE(refined.parameters().time.dynamic);
+  EXPECT_EQ(refined.mesh().n_global_cells, 4 * solid.mesh().n_global_cells);
 }
 
 }  // namespace

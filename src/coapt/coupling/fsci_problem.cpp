@@ -87,9 +87,8 @@ Parameters read(const config::Section& root) {
   p.level = root.section("mesh", "refinement of every mesh of the case")
                 .get<int>("level", 0,
                           {"",
-                           "added to the refinement level of the fluid mesh and of every rigid "
-                           "solid's mesh (each level halves the element sizes); a deformable "
-                           "solid's mesh takes its own solids[].mesh.level",
+                           "added to the refinement level of the fluid mesh and of every "
+                           "solid's mesh (each level halves the element sizes)",
                            Bounds::closed(0, 12)});
   const auto fluid = root.section(
       "fluid", "the fluid: mesh, boundary, outlets, pressure_reference and its material keys");
@@ -211,7 +210,7 @@ Parameters read(const config::Section& root) {
         "solids", {}, {"", "solids whose force B^T lambda adds to drag and lift"});
     b.probe_solid = benchmark.get<std::string>("probe_solid", "", {"", "solid of the probe"});
     b.probe = benchmark.get<std::string>(
-        "probe", "", {"", "a probe of that solid: displacement_x, displacement_y"});
+        "probe", "", {"", "a probe of that solid: displacement_x, displacement_y (and _z in 3D)"});
     auto reference = benchmark.section("reference", "published values (relative errors)");
     b.reference_drag_force = reference.get<double>("drag", 0.0, {"N/m", "drag (0: none)"});
     b.reference_lift_force = reference.get<double>("lift", 0.0, {"N/m", "lift (0: none)"});
@@ -312,12 +311,19 @@ class FsciProblem final : public run::Problem {
       solid->entry = &entry;
       if (entry.rigid) {
         auto input = entry.mesh;
-        fluid::add_refinement_levels(input, parameters_.level, "mesh.level");
+        mesh::add_refinement_levels(input, parameters_.level, "mesh.level");
         solid->mesh = mesh::load_mesh(input, comm, &solid->quality);
         if (!entry.velocity.empty() && static_cast<int>(entry.velocity.size()) != dim)
           throw InputError(fmt::format("{}: velocity: needs {} components", entry.where, dim));
       } else {
-        solid->model = std::make_unique<solid::SolidModel>(*entry.section, comm);
+        const bool transient = !parameters_.time.steady;
+        solid->model = std::make_unique<solid::SolidModel>(
+            *entry.section, comm,
+            solid::SolidModelOptions{parameters_.level, "mesh.level", transient});
+        if (transient) {  // the fluid mesh carries ρ_f over the overlap
+          solid->model->set_density_offset(parameters_.fluid.fluid.density);
+          solid->model->set_contact_stabilized(entry.contact_stabilized);
+        }
         if (entry.contact.enabled()) {
           solid->contact = std::make_unique<contact::ContactHook>(entry.contact, *solid->model);
           solid->model->set_hook(solid->contact.get());
@@ -436,11 +442,7 @@ class FsciProblem final : public run::Problem {
     const auto& p = parameters_;
     if (!p.time.steady)
       for (auto& solid : solids_)
-        if (solid->model) {  // the fluid mesh carries ρ_f over the overlap
-          solid->model->set_density_offset(p.fluid.fluid.density);
-          solid->model->set_contact_stabilized(solid->entry->contact_stabilized);
-          solid->model->initialize_dynamics(output);
-        }
+        if (solid->model) solid->model->initialize_dynamics(output);
     int newton_total = 0, linear_total = 0, coupling_total = 0;
     int last_vtk_step = -1, n_steps_done = 0;  // transient VTK: the last step written
     if (p.time.steady) {
@@ -1139,14 +1141,16 @@ class FsciProblem final : public run::Problem {
     json["cells"] = static_cast<std::int64_t>(mesh.n_global_cells);
     json["vertices"] = static_cast<std::int64_t>(mesh.n_global_vertices);
     json["force_balance_error"] = force_balance_;
+    const char* force_unit = mesh.dim == 2 ? "N/m" : "N";
     for (const auto& solid : solids_) {
       auto& entry = json["solids"][solid->entry->name];
       entry["cells"] = static_cast<std::int64_t>(solid->mesh.n_global_cells);
       entry["constrained_fluid_vertices"] =
           static_cast<std::int64_t>(solid->constraint->n_constrained());
       entry["force"] = io::Json::array_of(solid->total_force);
-      log::info("solid '{}': {} constrained fluid vertices, force ({:.8e}) N/m", solid->entry->name,
-                solid->constraint->n_constrained(), fmt::join(solid->total_force, ", "));
+      log::info("solid '{}': {} constrained fluid vertices, force ({:.8e}) {}", solid->entry->name,
+                solid->constraint->n_constrained(), fmt::join(solid->total_force, ", "),
+                force_unit);
     }
     log::info("force balance: max |sum B^T lambda - sum reactions| / |sum reactions| = {:.3e}",
               force_balance_);
@@ -1155,7 +1159,7 @@ class FsciProblem final : public run::Problem {
       const auto force = benchmark_force();
       json["drag"] = force[0];
       json["lift"] = force[1];
-      log::info("drag = {:.8g} N/m, lift = {:.8g} N/m", force[0], force[1]);
+      log::info("drag = {:.8g} {}, lift = {:.8g} {}", force[0], force_unit, force[1], force_unit);
       if (b.reference_drag_force != 0)
         json["drag_error"] = std::abs(force[0] / b.reference_drag_force - 1);
       if (b.reference_lift_force != 0)
@@ -1164,7 +1168,8 @@ class FsciProblem final : public run::Problem {
         const auto u = find_solid(b.probe_solid)->model->probe_values()[probe_index_];
         json["displacement_x"] = u[0];
         json["displacement_y"] = u[1];
-        log::info("probe '{}': u = ({:.8g}, {:.8g}) m", b.probe, u[0], u[1]);
+        if (u.size() == 3) json["displacement_z"] = u[2];
+        log::info("probe '{}': u = ({:.8g}) m", b.probe, fmt::join(u, ", "));
         if (b.reference_displacement_x != 0)
           json["displacement_x_error"] = std::abs(u[0] / b.reference_displacement_x - 1);
         if (b.reference_displacement_y != 0)

@@ -239,20 +239,9 @@ std::vector<double> values_at(const mesh::Mesh& mesh, Vec vector, int n_componen
   return values;
 }
 
-void add_refinement_levels(mesh::MeshInput& input, int levels, const std::string& where) {
-  if (levels == 0) return;
-  if (input.type == "gmsh")
-    throw InputError(
-        fmt::format("{}: the mesh {} is read from a file and cannot be refined (use a "
-                    ".geo file with type: geo)",
-                    where, input.file));
-  input.level += levels;
-  for (auto& n : input.cells) n <<= levels;
-}
-
 FluidModel::FluidModel(FluidCase parameters, MPI_Comm comm, int level_offset)
     : parameters_([&] {
-        add_refinement_levels(parameters.mesh, level_offset, "mesh.level");
+        mesh::add_refinement_levels(parameters.mesh, level_offset, "mesh.level");
         return std::move(parameters);
       }()),
       comm_(comm),

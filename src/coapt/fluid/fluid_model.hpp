@@ -110,11 +110,6 @@ struct TimeSettings {
   int n_steps() const;
 };
 
-/// Adds `levels` refinement levels to a mesh input (geo sizes and generator cell counts halve
-/// per level); InputError naming `where` for a mesh read from a .msh file, which cannot be
-/// refined.
-void add_refinement_levels(mesh::MeshInput& input, int levels, const std::string& where);
-
 /// Values of component `component` of a vertex vector with `n_components` per vertex at
 /// `points` (n × dim, row-major), each from the owned cell that contains it (NaN where none
 /// does; the lowest rank's value on partition boundaries). Collective.

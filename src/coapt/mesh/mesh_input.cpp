@@ -14,6 +14,17 @@ namespace coapt::mesh {
 
 using config::Bounds;
 
+void add_refinement_levels(MeshInput& input, int levels, const std::string& where) {
+  if (levels == 0) return;
+  if (input.type == "gmsh")
+    throw InputError(
+        fmt::format("{}: the mesh {} is read from a file and cannot be refined (use a "
+                    ".geo file with type: geo)",
+                    where, input.file));
+  input.level += levels;
+  for (auto& n : input.cells) n <<= levels;
+}
+
 MeshInput MeshInput::read(const config::Section& section, const std::string& case_directory) {
   MeshInput input;
   input.type = section.choice("type", "", {"rectangle", "box", "gmsh", "geo"},

@@ -34,6 +34,11 @@ struct MeshInput {
   std::string describe() const;
 };
 
+/// Adds `levels` refinement levels to a mesh input (geo sizes and generator cell counts halve
+/// per level); InputError naming `where` for a mesh read from a .msh file, which cannot be
+/// refined.
+void add_refinement_levels(MeshInput& input, int levels, const std::string& where);
+
 /// Loads (on rank 0), checks quality (inverted or degenerate cells are an InputError naming
 /// them) and distributes the mesh over `comm`. Collective. `report` receives the quality
 /// report of the whole mesh (on every rank).

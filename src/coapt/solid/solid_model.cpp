@@ -89,12 +89,21 @@ class WriteArray {
   PetscScalar* data_ = nullptr;
 };
 
+/// The case's keys with what a driver owning the solid sets (SolidModelOptions).
+SolidParameters read_parameters(const config::Section& root, const SolidModelOptions& options) {
+  auto parameters = SolidParameters::read(root);
+  mesh::add_refinement_levels(parameters.mesh, options.extra_mesh_levels, options.extra_levels_key);
+  if (options.driver_dynamic) parameters.time.dynamic = true;
+  return parameters;
+}
+
 }  // namespace
 
 class SolidModelImpl {
  public:
-  SolidModelImpl(const config::Section& root, MPI_Comm comm)
-      : parameters_(SolidParameters::read(root)),
+  SolidModelImpl(const config::Section& root, MPI_Comm comm, const SolidModelOptions& options)
+      : parameters_(read_parameters(root, options)),
+        driver_dynamic_(options.driver_dynamic),
         comm_(comm),
         mesh_(mesh::load_mesh(parameters_.mesh, comm, &quality_)),
         dim_(mesh_.dim),
@@ -163,10 +172,13 @@ class SolidModelImpl {
       log::info("follower pressure on '{}': {:g} Pa", load.boundary, load.pressure);
     if (density_offset_ != 0)
       log::info("inertia density: body density - {:g} kg/m^3", density_offset_);
-    if (parameters_.time.dynamic)
-      log::info("{} (beta 1/4, gamma 1/2): {} steps of {:g} s to t = {:g} s",
-                parameters_.time.contact_stabilized ? "contact-stabilized Newmark, lumped mass"
-                                                    : "Newmark, consistent mass",
+    const char* scheme = parameters_.time.contact_stabilized
+                             ? "contact-stabilized Newmark, lumped mass"
+                             : "Newmark, consistent mass";
+    if (driver_dynamic_)
+      log::info("{} (beta 1/4, gamma 1/2): the coupling's time steps", scheme);
+    else if (parameters_.time.dynamic)
+      log::info("{} (beta 1/4, gamma 1/2): {} steps of {:g} s to t = {:g} s", scheme,
                 parameters_.time.n_steps, parameters_.time.step, parameters_.time.end_time);
     else
       log::info("{} load step(s)", parameters_.steps);
@@ -1516,6 +1528,7 @@ class SolidModelImpl {
   }
 
   SolidParameters parameters_;
+  bool driver_dynamic_ = false;  ///< SolidModelOptions::driver_dynamic: the driver steps it
   MPI_Comm comm_;
   mesh::QualityReport quality_;
   mesh::Mesh mesh_;
@@ -1557,8 +1570,8 @@ class SolidModelImpl {
 
 }  // namespace detail
 
-SolidModel::SolidModel(const config::Section& root, MPI_Comm comm)
-    : impl_(std::make_unique<detail::SolidModelImpl>(root, comm)) {}
+SolidModel::SolidModel(const config::Section& root, MPI_Comm comm, const SolidModelOptions& options)
+    : impl_(std::make_unique<detail::SolidModelImpl>(root, comm, options)) {}
 SolidModel::~SolidModel() = default;
 
 const mesh::Mesh& SolidModel::mesh() const {

@@ -101,6 +101,19 @@ struct StepReport {
   double norm() const { return history.empty() ? 0.0 : history.back(); }
 };
 
+/// What a driver that owns the solid sets when it builds it (the immersed coupling, whose
+/// `solids[]` entry has the solid's keys but no `time:` of its own); a `problem: solid` case
+/// takes the defaults.
+struct SolidModelOptions {
+  /// Refinement levels added to the solid's mesh.level (the coupling's global mesh.level).
+  int extra_mesh_levels = 0;
+  /// The key named when those levels cannot be added (a mesh read from a .msh file).
+  std::string extra_levels_key = "mesh.level";
+  /// The driver advances the solid by step() with its own time steps: the solid is dynamic
+  /// (Newmark, mass, the direct linear solver of `time.scheme: newmark`) without `time:` keys.
+  bool driver_dynamic = false;
+};
+
 namespace detail {
 class SolidModelImpl;
 }
@@ -110,8 +123,9 @@ class SolidModel {
  public:
   /// Reads every key of a `problem: solid` case section (SolidParameters), loads and
   /// distributes the mesh, assigns bodies, collects Dirichlet dofs and locates probes.
-  /// InputError naming the key, group or point on bad input.
-  SolidModel(const config::Section& root, MPI_Comm comm);
+  /// InputError naming the key, group or point on bad input. `options`: what a driver owning
+  /// the solid sets (SolidModelOptions).
+  SolidModel(const config::Section& root, MPI_Comm comm, const SolidModelOptions& options = {});
   SolidModel(const SolidModel&) = delete;
   SolidModel& operator=(const SolidModel&) = delete;
   ~SolidModel();
