@@ -268,9 +268,10 @@ inline void element_residual_and_jacobian_by_differentiation(const ElementData<D
 /// The element residual r ((Dim+1)² entries, may be null) and its Jacobian K (row-major,
 /// (Dim+1)²×(Dim+1)², K[row·(Dim+1)² + col] = ∂r_row/∂x_col) at the unknowns x, τ frozen as in
 /// `e`. K is the derivative of element_residual written out term by term (the same as
-/// differentiating it, at a fraction of the cost). With D_b = λ_b α₀/Δt + u·∇λ_b (the
-/// derivative of ρ⁻¹ r_M,i with respect to u_i at vertex b, besides λ_b ∂_k u_i from u·∇u),
-/// at each quadrature point (weight w):
+/// differentiating it, about a tenth of the cost: the quadrature sums below are formed as
+/// (Dim+1)×(Dim+1) tables first, then every entry is written once). With D_b = λ_b α₀/Δt + u·∇λ_b
+/// (the derivative of ρ⁻¹ r_M,i with respect to u_i at vertex b, besides λ_b ∂_k u_i from u·∇u), at
+/// each quadrature point (weight w):
 ///   ∂R_(a,i)/∂u_(b,k) += w ρ (λ_a + τ_M u·∇λ_a)(δ_ik D_b + λ_b ∂_k u_i) + w τ_M λ_b ∂_k λ_a r_M,i
 ///   ∂R_(a,i)/∂p_b     += −w λ_b ∂_i λ_a + w τ_M (u·∇λ_a) ∂_i λ_b
 ///   ∂R_(a,p)/∂u_(b,k) += w λ_a ∂_k λ_b + w τ_M (∂_k λ_a D_b + λ_b Σ_i ∂_i λ_a ∂_k u_i)
@@ -306,24 +307,10 @@ inline void element_residual_and_jacobian(const ElementData<Dim>& e, const doubl
       gu[a][k] = sum;
     }
   }
-  // The constant viscous and LSIC terms.
-  const double viscous = e.measure * mu, lsic = e.measure * rho * e.tau_c;
-  for (int a = 0; a < n; ++a)
-    for (int i = 0; i < Dim; ++i) {
-      double* row = K + (a * n + i) * m;
-      for (int b = 0; b < n; ++b) {
-        for (int k = 0; k < Dim; ++k) {
-          double value = lsic * g[a][i] * g[b][k];
-          if (k == i) value += viscous * gg[a][b];
-          if (stress) value += viscous * g[a][k] * g[b][i];
-          row[b * n + k] = value;
-        }
-        row[b * n + Dim] = 0.0;
-      }
-    }
-  for (int a = 0; a < n; ++a)
-    for (int col = 0; col < m; ++col) K[(a * n + Dim) * m + col] = 0.0;
-
+  // The quadrature sums, so that the (Dim+1)⁴ entries are written once:
+  //   TD[a][b] = Σ w (λ_a + τ u·∇λ_a) D_b,  TL[a][b] = Σ w (λ_a + τ u·∇λ_a) λ_b,
+  //   SL[b][i] = Σ w λ_b r_M,i,  A[a] = Σ w u·∇λ_a,  DS[b] = Σ w D_b  (Σ w λ_b = |T|/n).
+  double TD[n][n] = {}, TL[n][n] = {}, SL[n][Dim] = {}, A[n] = {}, DS[n] = {};
   using Rule = Degree2Rule<Dim>;
   for (int q = 0; q < Rule::n; ++q) {
     const double w = Rule::weight * e.measure;
@@ -342,39 +329,48 @@ inline void element_residual_and_jacobian(const ElementData<Dim>& e, const doubl
         for (int j = 0; j < Dim; ++j) convective += u[j] * grad_u[i][j];
       strong[i] = rho * (udot[i] + convective) + grad_p[i];
     }
-    double advect[n], d[n], test[n];  // u·∇λ_a, D_a, w (λ_a + τ u·∇λ_a)
+    double d[n], test[n];  // D_a, w (λ_a + τ u·∇λ_a)
     for (int a = 0; a < n; ++a) {
-      double sum = 0;
+      double advect = 0;  // u·∇λ_a
       if (convection)
-        for (int j = 0; j < Dim; ++j) sum += g[a][j] * u[j];
-      advect[a] = sum;
-      d[a] = lambda[a] * e.mass_coefficient + sum;
-      test[a] = w * (lambda[a] + tau * sum);
+        for (int j = 0; j < Dim; ++j) advect += g[a][j] * u[j];
+      d[a] = lambda[a] * e.mass_coefficient + advect;
+      test[a] = w * (lambda[a] + tau * advect);
+      A[a] += w * advect;
+      DS[a] += w * d[a];
+      for (int i = 0; i < Dim; ++i) SL[a][i] += w * lambda[a] * strong[i];
     }
-    const double wt = w * tau;
-    for (int a = 0; a < n; ++a) {
-      for (int i = 0; i < Dim; ++i) {
-        double* row = K + (a * n + i) * m;
-        const double supg_strong = convection ? wt * strong[i] : 0.0;
-        for (int b = 0; b < n; ++b) {
-          const double mass = rho * test[a];
-          for (int k = 0; k < Dim; ++k) {
-            double value = convection ? mass * lambda[b] * grad_u[i][k] : 0.0;
-            if (k == i) value += mass * d[b];
-            row[b * n + k] += value + supg_strong * lambda[b] * g[a][k];
-          }
-          row[b * n + Dim] += -w * lambda[b] * g[a][i] + wt * advect[a] * g[b][i];
-        }
+    for (int a = 0; a < n; ++a)
+      for (int b = 0; b < n; ++b) {
+        TD[a][b] += test[a] * d[b];
+        TL[a][b] += test[a] * lambda[b];
       }
-      double* row = K + (a * n + Dim) * m;
+  }
+  // Every entry once: the quadrature sums plus the constant viscous and LSIC terms.
+  const double mean = e.measure / n;  // Σ w λ_b
+  const double viscous = e.measure * mu, lsic = e.measure * rho * e.tau_c;
+  for (int a = 0; a < n; ++a) {
+    for (int i = 0; i < Dim; ++i) {
+      double* row = K + (a * n + i) * m;
       for (int b = 0; b < n; ++b) {
         for (int k = 0; k < Dim; ++k) {
-          double value = w * lambda[a] * g[b][k] + wt * g[a][k] * d[b];
-          if (convection) value += wt * lambda[b] * gu[a][k];
-          row[b * n + k] += value;
+          double value = lsic * g[a][i] * g[b][k];
+          if (stress) value += viscous * g[a][k] * g[b][i];
+          if (convection) value += rho * grad_u[i][k] * TL[a][b] + tau * g[a][k] * SL[b][i];
+          if (k == i) value += viscous * gg[a][b] + rho * TD[a][b];
+          row[b * n + k] = value;
         }
-        row[b * n + Dim] += wt / rho * gg[a][b];
+        row[b * n + Dim] = -mean * g[a][i] + tau * A[a] * g[b][i];
       }
+    }
+    double* row = K + (a * n + Dim) * m;
+    for (int b = 0; b < n; ++b) {
+      for (int k = 0; k < Dim; ++k) {
+        double value = mean * g[b][k] + tau * g[a][k] * DS[b];
+        if (convection) value += tau * mean * gu[a][k];
+        row[b * n + k] = value;
+      }
+      row[b * n + Dim] = tau / rho * e.measure * gg[a][b];
     }
   }
 }
