@@ -33,9 +33,10 @@ struct Benchmark {
   std::vector<double> reference_y, reference_u, reference_x, reference_v;
   int profile_points = 129;
   // cylinder (coefficients) and obstacle (forces): body group, normalisation, pressure
-  // probes, reference values, start of the oscillation statistics of transient runs
+  // probes, reference values, start of the oscillation statistics of transient runs; height
+  // is the span H of a 3D body
   std::string body;
-  double mean_velocity = 1, diameter = 1;
+  double mean_velocity = 1, diameter = 1, height = 1;
   std::vector<double> pressure_points;  ///< x_A, y_A, x_B, y_B: Δp = p(A) − p(B)
   double reference_drag = 0, reference_lift = 0, reference_pressure_difference = 0;
   double statistics_from = 0;  ///< [s]
@@ -85,6 +86,8 @@ Parameters read(const config::Section& root) {
           "mean_velocity", {"m/s", "Ū of c = 2F/(ρŪ²D)", Bounds::positive()});
       b.diameter =
           benchmark.require<double>("diameter", {"m", "D of c = 2F/(ρŪ²D)", Bounds::positive()});
+      b.height = benchmark.get<double>(
+          "height", 1.0, {"m", "3D: the span H in c = 2F/(ρŪ²DH)", Bounds::positive()});
     }
     b.pressure_points = benchmark.get<std::vector<double>>(
         "pressure_points", {}, {"m", "x_A, y_A, x_B, y_B: Δp = p(A) − p(B) (steady runs)"});
@@ -302,11 +305,14 @@ class FlowProblem final : public run::Problem {
     series.end_row();
   }
 
-  /// 2/(ρŪ²D) for the cylinder's coefficients, 1 for the obstacle's forces.
+  /// 2/(ρŪ²D) (2D) or 2/(ρŪ²DH) (3D) for the cylinder's coefficients, 1 for the obstacle's
+  /// forces.
   double force_scale() const {
     const auto& b = parameters_.benchmark;
     if (b.type != "cylinder") return 1.0;
-    return 2.0 / (parameters_.fluid.fluid.density * b.mean_velocity * b.mean_velocity * b.diameter);
+    const double span = mesh_.dim == 3 ? b.height : 1.0;
+    return 2.0 / (parameters_.fluid.fluid.density * b.mean_velocity * b.mean_velocity * b.diameter *
+                  span);
   }
 
   /// Transient runs with a body: drag and lift (coefficients or forces) over their last full

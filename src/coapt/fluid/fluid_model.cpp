@@ -97,13 +97,17 @@ FluidCase FluidCase::read(const config::Section& section, const config::Section&
     if (bc.type == BoundaryCondition::Type::velocity) {
       bc.value = entry.require<std::vector<double>>(
           "value", {"m/s", "velocity vector (the peak for a parabolic profile)"});
-      const auto profile = entry.choice(
-          "profile", "constant", {"constant", "parabolic", "radial"},
-          {"", "constant | parabolic (between `from` and `to`) | radial (about `centre`)"});
-      if (profile == "parabolic") {
-        bc.profile = BoundaryCondition::Profile::parabolic;
-        bc.from = entry.require<std::vector<double>>("from", {"m", "one end of the profile"});
-        bc.to = entry.require<std::vector<double>>("to", {"m", "the other end"});
+      const auto profile =
+          entry.choice("profile", "constant", {"constant", "parabolic", "rectangle", "radial"},
+                       {"",
+                        "constant | parabolic (between `from` and `to`) | rectangle (over the box "
+                        "`from`–`to`) | radial (about `centre`)"});
+      if (profile == "parabolic" || profile == "rectangle") {
+        bc.profile = profile == "parabolic" ? BoundaryCondition::Profile::parabolic
+                                            : BoundaryCondition::Profile::rectangle;
+        bc.from = entry.require<std::vector<double>>(
+            "from", {"m", "one end of the profile (rectangle: a corner of the inlet)"});
+        bc.to = entry.require<std::vector<double>>("to", {"m", "the other end (opposite corner)"});
       } else if (profile == "radial") {
         bc.profile = BoundaryCondition::Profile::radial;
         bc.centre = entry.require<std::vector<double>>(
@@ -258,7 +262,8 @@ FluidModel::FluidModel(FluidCase parameters, MPI_Comm comm, int level_offset)
     if (bc.type != BoundaryCondition::Type::velocity) continue;
     if (static_cast<int>(bc.value.size()) != dim)
       throw InputError(fmt::format("{}: value: needs {} components", bc.where, dim));
-    if (bc.profile == BoundaryCondition::Profile::parabolic &&
+    if ((bc.profile == BoundaryCondition::Profile::parabolic ||
+         bc.profile == BoundaryCondition::Profile::rectangle) &&
         (static_cast<int>(bc.from.size()) != dim || static_cast<int>(bc.to.size()) != dim))
       throw InputError(fmt::format("{}: from/to: need {} coordinates each", bc.where, dim));
     if (bc.profile == BoundaryCondition::Profile::radial &&
@@ -566,6 +571,15 @@ void FluidModel::write_boundary_values(double time) {
         }
         const double s = std::clamp(along / length2, 0.0, 1.0);
         factor *= 4 * s * (1 - s);
+      } else if (bc.profile == BoundaryCondition::Profile::rectangle) {
+        // Per coordinate i in which the box has extent, s_i ∈ [0, 1] from from_i to to_i: the
+        // product Π 4 s_i (1 − s_i) peaks at the centre of the inlet and vanishes on its edges.
+        for (int i = 0; i < dim; ++i) {
+          const double extent = bc.to[i] - bc.from[i];
+          if (extent == 0) continue;
+          const double s = std::clamp((mesh_.point(v)[i] - bc.from[i]) / extent, 0.0, 1.0);
+          factor *= 4 * s * (1 - s);
+        }
       } else if (bc.profile == BoundaryCondition::Profile::radial) {
         double r2 = 0;
         for (int i = 0; i < dim; ++i) r2 += std::pow(mesh_.point(v)[i] - bc.centre[i], 2);

@@ -59,13 +59,13 @@ struct TimeWaveform {
 /// One entry of `boundary:`; later entries override earlier ones at shared vertices.
 struct BoundaryCondition {
   enum class Type { velocity, no_slip, outflow };
-  enum class Profile { constant, parabolic, radial };
+  enum class Profile { constant, parabolic, rectangle, radial };
   std::string group;
   std::string where;  ///< file:line of the entry
   Type type = Type::no_slip;
   Profile profile = Profile::constant;
   std::vector<double> value;     ///< velocity (peak for parabolic) [m/s]
-  std::vector<double> from, to;  ///< parabolic: the two ends of the profile [m]
+  std::vector<double> from, to;  ///< parabolic: the two ends; rectangle: opposite corners [m]
   double ramp_time = 0;          ///< > 0: value × (1 − cos(π min(t/T, 1)))/2 [s]
   std::vector<double> centre;    ///< radial: the axis point of the inlet plane [m]
   double radius = 0;             ///< radial: value × (1 − r²/radius²) [m]

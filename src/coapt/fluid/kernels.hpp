@@ -36,9 +36,10 @@
 /// residual is differentiated (everything else, including u in the SUPG test function u·∇w, is
 /// linearised exactly).
 ///
-/// The Jacobian is the exact derivative of the element residual (with τ frozen), computed by
-/// forward-mode differentiation with the small Dual type below; the residual is integrated
-/// exactly (its integrand is at most quadratic) by degree-2 rules.
+/// The Jacobian is the exact derivative of the element residual (with τ frozen), written out
+/// in element_residual_and_jacobian and checked against forward-mode differentiation with the
+/// small Dual type below (which the backflow term uses); the residual is integrated exactly
+/// (its integrand is at most quadratic) by degree-2 rules.
 
 #include <array>
 #include <cmath>
@@ -244,11 +245,13 @@ inline void element_residual(const ElementData<Dim>& e, const S* x, S* r) {
   }
 }
 
-/// The element residual r ((Dim+1)² entries) and its Jacobian K (row-major, (Dim+1)²×(Dim+1)²,
-/// K[row·(Dim+1)² + col] = ∂r_row/∂x_col) at the unknowns x, τ frozen as in `e`.
+/// The element residual r ((Dim+1)² entries, may be null) and its Jacobian K by forward-mode
+/// differentiation of element_residual (row-major, K[row·(Dim+1)² + col] = ∂r_row/∂x_col), τ
+/// frozen as in `e`: the reference for element_residual_and_jacobian (tests/unit/fluid).
 template <int Dim>
-inline void element_residual_and_jacobian(const ElementData<Dim>& e, const double* x, double* r,
-                                          double* K) {
+inline void element_residual_and_jacobian_by_differentiation(const ElementData<Dim>& e,
+                                                             const double* x, double* r,
+                                                             double* K) {
   constexpr int m = (Dim + 1) * (Dim + 1);
   Dual<m> xd[m], rd[m];
   for (int k = 0; k < m; ++k) {
@@ -259,6 +262,116 @@ inline void element_residual_and_jacobian(const ElementData<Dim>& e, const doubl
   for (int row = 0; row < m; ++row) {
     if (r) r[row] = rd[row].v;
     for (int col = 0; col < m; ++col) K[row * m + col] = rd[row].d[col];
+  }
+}
+
+/// The element residual r ((Dim+1)² entries, may be null) and its Jacobian K (row-major,
+/// (Dim+1)²×(Dim+1)², K[row·(Dim+1)² + col] = ∂r_row/∂x_col) at the unknowns x, τ frozen as in
+/// `e`. K is the derivative of element_residual written out term by term (the same as
+/// differentiating it, about a tenth of the cost: the quadrature sums below are formed as
+/// (Dim+1)×(Dim+1) tables first, then every entry is written once). With D_b = λ_b α₀/Δt + u·∇λ_b
+/// (the derivative of ρ⁻¹ r_M,i with respect to u_i at vertex b, besides λ_b ∂_k u_i from u·∇u), at
+/// each quadrature point (weight w):
+///   ∂R_(a,i)/∂u_(b,k) += w ρ (λ_a + τ_M u·∇λ_a)(δ_ik D_b + λ_b ∂_k u_i) + w τ_M λ_b ∂_k λ_a r_M,i
+///   ∂R_(a,i)/∂p_b     += −w λ_b ∂_i λ_a + w τ_M (u·∇λ_a) ∂_i λ_b
+///   ∂R_(a,p)/∂u_(b,k) += w λ_a ∂_k λ_b + w τ_M (∂_k λ_a D_b + λ_b Σ_i ∂_i λ_a ∂_k u_i)
+///   ∂R_(a,p)/∂p_b     += (w τ_M / ρ) ∇λ_a·∇λ_b
+/// (the terms with u·∇ dropped for Stokes), plus the constant viscous and LSIC terms
+/// |T| μ (δ_ik ∇λ_a·∇λ_b [+ ∂_k λ_a ∂_i λ_b, stress form]) + |T| ρ τ_C ∂_i λ_a ∂_k λ_b.
+template <int Dim>
+inline void element_residual_and_jacobian(const ElementData<Dim>& e, const double* x, double* r,
+                                          double* K) {
+  constexpr int n = Dim + 1, m = n * n;
+  if (r) element_residual<Dim, double>(e, x, r);
+  const auto& g = e.gradients;
+  const double rho = e.density, mu = e.viscosity, tau = e.tau_m;
+  const bool convection = e.convection, stress = e.viscous_form == ViscousForm::stress;
+  // Constant gradients: grad_u[i][k] = ∂_k u_i, grad_p, and the products ∇λ_a·∇λ_b and
+  // gu[a][k] = Σ_i ∂_i λ_a ∂_k u_i.
+  double grad_u[Dim][Dim] = {}, grad_p[Dim] = {};
+  for (int a = 0; a < n; ++a)
+    for (int k = 0; k < Dim; ++k) {
+      for (int i = 0; i < Dim; ++i) grad_u[i][k] += g[a][k] * x[a * n + i];
+      grad_p[k] += g[a][k] * x[a * n + Dim];
+    }
+  double gg[n][n], gu[n][Dim];
+  for (int a = 0; a < n; ++a) {
+    for (int b = 0; b < n; ++b) {
+      double sum = 0;
+      for (int i = 0; i < Dim; ++i) sum += g[a][i] * g[b][i];
+      gg[a][b] = sum;
+    }
+    for (int k = 0; k < Dim; ++k) {
+      double sum = 0;
+      for (int i = 0; i < Dim; ++i) sum += g[a][i] * grad_u[i][k];
+      gu[a][k] = sum;
+    }
+  }
+  // The quadrature sums, so that the (Dim+1)⁴ entries are written once:
+  //   TD[a][b] = Σ w (λ_a + τ u·∇λ_a) D_b,  TL[a][b] = Σ w (λ_a + τ u·∇λ_a) λ_b,
+  //   SL[b][i] = Σ w λ_b r_M,i,  A[a] = Σ w u·∇λ_a,  DS[b] = Σ w D_b  (Σ w λ_b = |T|/n).
+  double TD[n][n] = {}, TL[n][n] = {}, SL[n][Dim] = {}, A[n] = {}, DS[n] = {};
+  using Rule = Degree2Rule<Dim>;
+  for (int q = 0; q < Rule::n; ++q) {
+    const double w = Rule::weight * e.measure;
+    double lambda[n];
+    for (int a = 0; a < n; ++a) lambda[a] = Rule::lambda(q, a);
+    double u[Dim] = {}, udot[Dim] = {};
+    for (int a = 0; a < n; ++a)
+      for (int i = 0; i < Dim; ++i) {
+        u[i] += lambda[a] * x[a * n + i];
+        udot[i] += lambda[a] * e.history[a][i] + lambda[a] * e.mass_coefficient * x[a * n + i];
+      }
+    double strong[Dim];  // r_M
+    for (int i = 0; i < Dim; ++i) {
+      double convective = 0;
+      if (convection)
+        for (int j = 0; j < Dim; ++j) convective += u[j] * grad_u[i][j];
+      strong[i] = rho * (udot[i] + convective) + grad_p[i];
+    }
+    double d[n], test[n];  // D_a, w (λ_a + τ u·∇λ_a)
+    for (int a = 0; a < n; ++a) {
+      double advect = 0;  // u·∇λ_a
+      if (convection)
+        for (int j = 0; j < Dim; ++j) advect += g[a][j] * u[j];
+      d[a] = lambda[a] * e.mass_coefficient + advect;
+      test[a] = w * (lambda[a] + tau * advect);
+      A[a] += w * advect;
+      DS[a] += w * d[a];
+      for (int i = 0; i < Dim; ++i) SL[a][i] += w * lambda[a] * strong[i];
+    }
+    for (int a = 0; a < n; ++a)
+      for (int b = 0; b < n; ++b) {
+        TD[a][b] += test[a] * d[b];
+        TL[a][b] += test[a] * lambda[b];
+      }
+  }
+  // Every entry once: the quadrature sums plus the constant viscous and LSIC terms.
+  const double mean = e.measure / n;  // Σ w λ_b
+  const double viscous = e.measure * mu, lsic = e.measure * rho * e.tau_c;
+  for (int a = 0; a < n; ++a) {
+    for (int i = 0; i < Dim; ++i) {
+      double* row = K + (a * n + i) * m;
+      for (int b = 0; b < n; ++b) {
+        for (int k = 0; k < Dim; ++k) {
+          double value = lsic * g[a][i] * g[b][k];
+          if (stress) value += viscous * g[a][k] * g[b][i];
+          if (convection) value += rho * grad_u[i][k] * TL[a][b] + tau * g[a][k] * SL[b][i];
+          if (k == i) value += viscous * gg[a][b] + rho * TD[a][b];
+          row[b * n + k] = value;
+        }
+        row[b * n + Dim] = -mean * g[a][i] + tau * A[a] * g[b][i];
+      }
+    }
+    double* row = K + (a * n + Dim) * m;
+    for (int b = 0; b < n; ++b) {
+      for (int k = 0; k < Dim; ++k) {
+        double value = mean * g[b][k] + tau * g[a][k] * DS[b];
+        if (convection) value += tau * mean * gu[a][k];
+        row[b * n + k] = value;
+      }
+      row[b * n + Dim] = tau / rho * e.measure * gg[a][b];
+    }
   }
 }
 

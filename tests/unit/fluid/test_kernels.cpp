@@ -1,5 +1,6 @@
 // Element kernels of the fluid: BDF weights, the stabilisation parameters' limits, and the
-// Jacobian (forward-mode) against central finite differences of the residual (τ frozen).
+// Jacobian against central finite differences of the residual (τ frozen) and against
+// forward-mode differentiation of it.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -120,6 +121,55 @@ TEST(FluidKernels, JacobianMatchesFiniteDifferences2D) {
 TEST(FluidKernels, JacobianMatchesFiniteDifferences3D) {
   check_jacobian<3>(false, true);
   check_jacobian<3>(true, true);
+}
+
+// The written-out Jacobian is the derivative of the residual to round-off: it matches the
+// forward-mode one in every combination of dimension, time term, convection and viscous form.
+template <int Dim>
+void check_against_differentiation(bool transient, bool convection,
+                                   coapt::fluid::ViscousForm form) {
+  constexpr int m = (Dim + 1) * (Dim + 1);
+  std::mt19937 random(7 + Dim);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  double e[Dim][Dim];
+  for (int k = 0; k < Dim; ++k)
+    for (int i = 0; i < Dim; ++i) e[k][i] = (k == i ? 0.2 : 0.0) + 0.06 * uniform(random);
+  ElementData<Dim> data;
+  const double det = coapt::fem::detail::gradients_from_edges<Dim>(e, data.gradients);
+  data.measure = std::abs(det) / coapt::fem::detail::factorial(Dim);
+  data.density = 1.1;
+  data.viscosity = 0.03;
+  data.convection = convection;
+  data.viscous_form = form;
+  if (transient) {
+    data.mass_coefficient = 1.5 / 0.02;
+    for (int a = 0; a <= Dim; ++a)
+      for (int i = 0; i < Dim; ++i) data.history[a][i] = 20 * uniform(random);
+  }
+  double x[m];
+  for (double& value : x) value = uniform(random);
+  double u[Dim];
+  for (int i = 0; i < Dim; ++i) u[i] = 0.5 * x[Dim + 1 + i];
+  coapt::fluid::set_stabilisation<Dim>(data, u, transient ? 0.02 : 0.0, 9.0);
+  double r[m], K[m * m], r_reference[m], K_reference[m * m];
+  coapt::fluid::element_residual_and_jacobian<Dim>(data, x, r, K);
+  coapt::fluid::element_residual_and_jacobian_by_differentiation<Dim>(data, x, r_reference,
+                                                                      K_reference);
+  double scale = 0;
+  for (double value : K_reference) scale = std::max(scale, std::abs(value));
+  for (int k = 0; k < m; ++k) EXPECT_EQ(r[k], r_reference[k]);
+  for (int k = 0; k < m * m; ++k)
+    EXPECT_NEAR(K[k], K_reference[k], 1e-13 * scale) << "row " << k / m << " col " << k % m;
+}
+
+TEST(FluidKernels, JacobianMatchesForwardModeDifferentiation) {
+  using coapt::fluid::ViscousForm;
+  for (const auto form : {ViscousForm::laplace, ViscousForm::stress})
+    for (const bool transient : {false, true})
+      for (const bool convection : {false, true}) {
+        check_against_differentiation<2>(transient, convection, form);
+        check_against_differentiation<3>(transient, convection, form);
+      }
 }
 
 TEST(FluidKernels, RigidMotionAndConstantPressureGiveNoViscousOrContinuityResidual) {
