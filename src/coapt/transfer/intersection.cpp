@@ -72,20 +72,27 @@ struct Overlap {
 };
 
 // table[j][k] = λ^T_j(p_k) for the vertices p_k of P, as T.barycentric(j, p_k) (same
-// operations in the same order), with P's coordinates transposed first so that the loop over
-// the vertices is a vector operation; lowest[j] and highest[j] are the extremes of row j.
+// operations in the same order), with P's coordinates relative to the anchors transposed
+// first so that the loop over the vertices is a vector operation; lowest[j] and highest[j] are the
+// extremes of row j.
 template <int dim>
 void barycentric_table(const Simplex<dim>& t, const Simplex<dim>& p, NodalMatrix<dim>& table,
                        NodalVector<dim>& lowest, NodalVector<dim>& highest) {
-  std::array<NodalVector<dim>, dim> coordinates;  // [c][k]: coordinate c of p_k
+  // [c][k]: coordinate c of p_k − t_1 (the anchor of λ_0) and of p_k − t_0 (that of the
+  // others), formed once instead of once per row
+  static_assert(Simplex<dim>::anchor(0) == 1 && Simplex<dim>::anchor(1) == 0);
+  std::array<NodalVector<dim>, dim> from_1, from_0;
   for (int k = 0; k <= dim; ++k)
-    for (int c = 0; c < dim; ++c) coordinates[c][k] = p.vertices[k][c];
+    for (int c = 0; c < dim; ++c) {
+      from_1[c][k] = p.vertices[k][c] - t.vertices[1][c];
+      from_0[c][k] = p.vertices[k][c] - t.vertices[0][c];
+    }
   for (int j = 0; j <= dim; ++j) {
-    const Point<dim>& anchor = t.vertices[Simplex<dim>::anchor(j)];
+    const std::array<NodalVector<dim>, dim>& relative = j == 0 ? from_1 : from_0;
     const Point<dim>& gradient = t.gradients[j];
     NodalVector<dim> value{};
     for (int c = 0; c < dim; ++c)
-      for (int k = 0; k <= dim; ++k) value[k] += gradient[c] * (coordinates[c][k] - anchor[c]);
+      for (int k = 0; k <= dim; ++k) value[k] += gradient[c] * relative[c][k];
     table[j] = value;
   }
   // extremes over k for all j at once (not fmin/fmax: those are library calls here)
@@ -223,7 +230,8 @@ Moments<dim> first_moments(const Simplex<dim>& s) {
 // returns the factor to apply to every integral (0 when the intersection is empty).
 template <int dim>
 double admissible_scale(double measure, const Simplex<dim>& a, const Simplex<dim>& b) {
-  const double limit = std::fmin(a.measure, b.measure);
+  // (not std::fmin: a library call here; the measures are finite and positive)
+  const double limit = a.measure < b.measure ? a.measure : b.measure;
   if (!(measure > kMeasureTolerance * limit) || !std::isfinite(measure)) return 0.0;
   return measure > limit ? limit / measure : 1.0;
 }
@@ -302,22 +310,15 @@ Contact integrals_of_intersection(const Simplex<dim>& a, const Simplex<dim>& b,
     case Kind::clipped: {
       const Moments<dim> reference = workspace.polytope.moments();
       moments = physical_moments(small, reference, workspace.second_moment);
-      // ū = λ^S(ξ̄) and the covariance of u = (1 − Σξ, ξ): C_u,kl = C_ξ,kl for k, l ≥ 1,
-      // C_u,0l = −Σ_k C_ξ,kl, C_u,00 = Σ_kl C_ξ,kl.
+      // ū = λ^S(ξ̄) = (1 − Σ_k ξ̄_k, ξ̄). λ^L_j(ξ) = β_j0 + Σ_l g_jl ξ_l with
+      // g_jl = β_j(l+1) − β_j0 (the normal of the clipping plane j), so the covariance
+      // ∫(λ^S_i − ū_i)(λ^L_j − λ^L_j(ξ̄)) / d!|S| is (C_ξ g_j)_(i−1) for i ≥ 1 and, as
+      // Σ_i λ^S_i = 1, minus the sum of those for i = 0.
       NodalVector<dim> u_bar;
-      NodalMatrix<dim> covariance;
       u_bar[0] = 1.0;
-      covariance[0][0] = 0.0;
       for (int k = 0; k < dim; ++k) {
         u_bar[k + 1] = reference.centroid[k];
         u_bar[0] -= reference.centroid[k];
-        double column = 0.0;
-        for (int l = 0; l < dim; ++l) {
-          covariance[k + 1][l + 1] = reference.second[k][l];
-          column += reference.second[k][l];
-        }
-        covariance[0][k + 1] = covariance[k + 1][0] = -column;
-        covariance[0][0] += column;
       }
       const double jacobian = factorial(dim) * small.measure;
       const double volume = jacobian * reference.measure;
@@ -325,11 +326,16 @@ Contact integrals_of_intersection(const Simplex<dim>& a, const Simplex<dim>& b,
         double l_bar = 0.0;  // λ^L_j(ξ̄)
         for (int k = 0; k <= dim; ++k) l_bar += overlap.beta[j][k] * u_bar[k];
         integral_l[j] = volume * l_bar;
-        for (int i = 0; i <= dim; ++i) {
+        Point<dim> g;
+        for (int l = 0; l < dim; ++l) g[l] = overlap.beta[j][l + 1] - overlap.beta[j][0];
+        double rest = 0.0;
+        for (int k = 0; k < dim; ++k) {
           double spread = 0.0;
-          for (int k = 0; k <= dim; ++k) spread += covariance[i][k] * overlap.beta[j][k];
-          mass[i][j] = volume * u_bar[i] * l_bar + jacobian * spread;
+          for (int l = 0; l < dim; ++l) spread += reference.second[k][l] * g[l];
+          mass[k + 1][j] = volume * u_bar[k + 1] * l_bar + jacobian * spread;
+          rest += spread;
         }
+        mass[0][j] = volume * u_bar[0] * l_bar - jacobian * rest;
       }
       for (int i = 0; i <= dim; ++i) integral_s[i] = volume * u_bar[i];
       break;
@@ -341,16 +347,27 @@ Contact integrals_of_intersection(const Simplex<dim>& a, const Simplex<dim>& b,
     out.crossed_faces_b = overlap.b_crossed;
     return Contact::touching;
   }
+  if (scale != 1.0) {  // nearly always 1: then nothing to multiply
+    moments.measure *= scale;
+    for (auto& row : moments.second)
+      for (double& value : row) value *= scale;
+    for (int i = 0; i <= dim; ++i) {
+      integral_s[i] *= scale;
+      integral_l[i] *= scale;
+      for (int j = 0; j <= dim; ++j) mass[i][j] *= scale;
+    }
+  }
   out.crossed_faces_b = overlap.b_crossed;
   out.moments = moments;
-  out.moments.measure *= scale;
-  for (auto& row : out.moments.second)
-    for (double& value : row) value *= scale;
-  for (int i = 0; i <= dim; ++i) {
-    out.integral_a[i] = scale * (overlap.a_is_small ? integral_s[i] : integral_l[i]);
-    out.integral_b[i] = scale * (overlap.a_is_small ? integral_l[i] : integral_s[i]);
-    for (int j = 0; j <= dim; ++j)
-      out.mass[i][j] = scale * (overlap.a_is_small ? mass[i][j] : mass[j][i]);
+  if (overlap.a_is_small) {
+    out.integral_a = integral_s;
+    out.integral_b = integral_l;
+    out.mass = mass;
+  } else {
+    out.integral_a = integral_l;
+    out.integral_b = integral_s;
+    for (int i = 0; i <= dim; ++i)
+      for (int j = 0; j <= dim; ++j) out.mass[i][j] = mass[j][i];
   }
   return Contact::overlapping;
 }
