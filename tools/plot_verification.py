@@ -44,7 +44,9 @@ ROOT = Path(__file__).resolve().parent.parent
 # case file -> list of (label, benchmark key, reference); reference None: the key is the error.
 SOLID = {
     "cases/cook/linear.yaml": [("Cook linear, u_y(48, 52)", "mid_edge_displacement_y", 23.96)],
-    "cases/cook/neohookean.yaml": [("Cook Neo-Hookean, u_y(48, 60)", "tip_displacement_y", 14.33e-3)],
+    "cases/cook/neohookean.yaml": [("Cook Neo-Hookean slab, u_y(48, 60)", "tip_displacement_y", 14.33e-3)],
+    "cases/cook/neohookean_plane_strain.yaml": [
+        ("Cook Neo-Hookean plane strain, u_y(48, 60)", "tip_displacement_y", 14.33e-3)],
     "cases/turek_hron/csm1.yaml": [("CSM1, u_x(A)", "A_displacement_x", -7.187e-3),
                                    ("CSM1, u_y(A)", "A_displacement_y", -66.10e-3)],
     "cases/turek_hron/csm2.yaml": [("CSM2, u_x(A)", "A_displacement_x", -0.4690e-3),
