@@ -727,22 +727,28 @@ class FsciProblem final : public run::Problem {
   /// One transient step of size dt, committed; a step whose coupling fails is retried with half
   /// the relaxation, then with half the step (the remaining time is covered by later steps);
   /// after `retries` failures the run fails with the history. The added-mass effect can make a
-  /// smaller step worse, which is why the relaxation is tried first.
+  /// smaller step worse, which is why the relaxation is tried first — unless a solid's solve
+  /// failed in the first coupling iteration: its load there is the last step's force, which
+  /// the relaxation does not change, so that try would repeat exactly; the step is halved.
   CouplingReport step_with_retries(run::RunOutput& output, double dt) {
     const auto& c = parameters_.coupling;
     double relaxation = c.relaxation, step = dt;
     std::string failures;
+    bool relaxation_tried = false;
     for (int attempt = 0; attempt <= c.retries; ++attempt) {
       if (attempt > 0) {
-        if (attempt == 1 || !deformable_)
+        if (!deformable_ || (!relaxation_tried && !first_solve_failed_)) {
           relaxation *= 0.5;
-        else
+          relaxation_tried = true;
+        } else {
           step *= 0.5;
+        }
         log::info("fsci: retrying the step to t = {:g} s with relaxation {:g} and step {:g} s",
                   fluid_.time() + step, relaxation, step);
       }
       fluid_.begin_step(step);
       StepResult result;
+      first_solve_failed_ = false;
       try {
         result = coupled_step(output, fluid_.time(), step, relaxation);
       } catch (const ConvergenceError& error) {
@@ -817,6 +823,7 @@ class FsciProblem final : public run::Problem {
             // A quasi-Newton force can overshoot where the map is not smooth (the set of
             // constrained fluid nodes changes as the solid moves): fall back once to the
             // relaxed update of the last iterate, x + ω r, without the columns.
+            first_solve_failed_ = iteration == 1;
             if (!quasi_newton_ || steady || iteration == 1 || fell_back) throw;
             log::warn("fsci: coupling iteration {}: {}; back to the relaxed update", iteration,
                       error.what());
@@ -1247,8 +1254,9 @@ class FsciProblem final : public run::Problem {
   MPI_Comm comm_;
   fluid::FluidModel fluid_;
   std::vector<std::unique_ptr<Solid>> solids_;
-  double force_balance_ = 0;  ///< max over solids of the relative force balance error
-  bool deformable_ = false;   ///< some solid is deformable: coupling iterations
+  double force_balance_ = 0;         ///< max over solids of the relative force balance error
+  bool deformable_ = false;          ///< some solid is deformable: coupling iterations
+  bool first_solve_failed_ = false;  ///< the last try failed in a solid's first solve of the step
   std::unique_ptr<InterfaceQuasiNewton> quasi_newton_;  ///< coupling.iteration.method iqn_ils
   int last_columns_ = 0;                                ///< columns of the last IQN-ILS update
   std::vector<int> boundary_tags_;                      ///< benchmark.boundaries
