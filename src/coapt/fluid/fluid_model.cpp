@@ -4,8 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <numbers>
+#include <sstream>
 
 #include "coapt/core/context.hpp"
 #include "coapt/core/error.hpp"
@@ -34,27 +37,85 @@ double TimeWaveform::factor(double time) const {
   return (1 - s) * factors[k - 1] + s * factors[k];
 }
 
+void TimeWaveform::parse_csv(const std::string& text, const std::string& name,
+                             std::vector<double>& times, std::vector<double>& factors) {
+  times.clear();
+  factors.clear();
+  std::istringstream lines(text);
+  std::string line;
+  bool header_allowed = true;
+  for (int number = 1; std::getline(lines, line); ++number) {
+    const auto comment = line.find('#');
+    if (comment != std::string::npos) line.erase(comment);
+    const std::string row = line;
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    std::replace(line.begin(), line.end(), ',', ' ');
+    std::istringstream fields(line);
+    double time = 0, factor = 0;
+    std::string rest;
+    const bool numbers = static_cast<bool>(fields >> time >> factor);
+    if (numbers && !(fields >> rest) && std::isfinite(time) && std::isfinite(factor)) {
+      if (!times.empty() && !(time > times.back()))
+        throw InputError(
+            fmt::format("{}:{}: time {:g} s does not increase (the row before: {:g} s)", name,
+                        number, time, times.back()));
+      times.push_back(time);
+      factors.push_back(factor);
+      header_allowed = false;
+      continue;
+    }
+    double first = 0;
+    std::istringstream probe(line);
+    if (header_allowed && !(probe >> first)) {  // a header line such as "time,factor"
+      header_allowed = false;
+      continue;
+    }
+    throw InputError(
+        fmt::format("{}:{}: expected two numbers 'time, factor', got '{}'", name, number, row));
+  }
+  if (times.size() < 2)
+    throw InputError(
+        fmt::format("{}: needs at least 2 rows 'time, factor', has {}", name, times.size()));
+}
+
 TimeWaveform TimeWaveform::read(const config::Section& waveform) {
   TimeWaveform w;
   const auto kind = waveform.choice(
-      "type", "none", {"none", "sinusoid", "table"},
-      {"", "none | sinusoid (1 + a sin(2πt/T)) | table (linear in time; steady runs: none)"});
+      "type", "none", {"none", "sinusoid", "table", "csv"},
+      {"",
+       "none | sinusoid (1 + a sin(2πt/T)) | table (linear in time; steady runs: none) | csv "
+       "(the table read from a file)"});
   if (kind == "sinusoid") {
     w.kind = Kind::sinusoid;
     w.amplitude = waveform.require<double>("amplitude", {"", "a of 1 + a sin(2πt/T)"});
     w.period = waveform.require<double>("period", {"s", "period T", Bounds::positive()});
-  } else if (kind == "table") {
+  } else if (kind == "table" || kind == "csv") {
     w.kind = Kind::table;
-    w.times = waveform.require<std::vector<double>>("times", {"s", "table times, increasing"});
-    w.factors = waveform.require<std::vector<double>>("values", {"", "factor at each time"});
+    if (kind == "table") {
+      w.times = waveform.require<std::vector<double>>("times", {"s", "table times, increasing"});
+      w.factors = waveform.require<std::vector<double>>("values", {"", "factor at each time"});
+      if (w.times.size() < 2 || w.times.size() != w.factors.size())
+        waveform.fail("values", "needs at least 2 entries, as many as times");
+      for (std::size_t k = 1; k < w.times.size(); ++k)
+        if (!(w.times[k] > w.times[k - 1])) waveform.fail("times", "must increase");
+    } else {
+      const auto file = waveform.require<std::string>(
+          "file", {"", "csv: rows 'time [s], factor', increasing times (relative to the case)"});
+      const std::filesystem::path path =
+          std::filesystem::path(file).is_absolute()
+              ? std::filesystem::path(file)
+              : (std::filesystem::path(waveform.case_directory()) / file).lexically_normal();
+      std::ifstream in(path);
+      if (!in)
+        waveform.fail("file", fmt::format("cannot read the waveform file {}", path.string()));
+      std::ostringstream text;
+      text << in.rdbuf();
+      parse_csv(text.str(), path.string(), w.times, w.factors);
+    }
     w.period =
         waveform.get<double>("period", 0.0,
                              {"s", "repeat the table with this period (0: hold the last value)",
                               Bounds::non_negative()});
-    if (w.times.size() < 2 || w.times.size() != w.factors.size())
-      waveform.fail("values", "needs at least 2 entries, as many as times");
-    for (std::size_t k = 1; k < w.times.size(); ++k)
-      if (!(w.times[k] > w.times[k - 1])) waveform.fail("times", "must increase");
   }
   return w;
 }

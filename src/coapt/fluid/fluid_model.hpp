@@ -42,8 +42,9 @@
 namespace coapt::fluid {
 
 /// A periodic or tabulated factor in time: none (1), sinusoid 1 + a sin(2πt/T), or a table
-/// linear between its points (repeated with `period` when > 0, else holding its ends). Steady
-/// solves (t = ∞) take 1.
+/// linear between its points (repeated with `period` when > 0, else holding its ends), given
+/// in the case (`table`) or read from a CSV file of time, factor rows (`csv`). Steady solves
+/// (t = ∞) take 1.
 struct TimeWaveform {
   enum class Kind { none, sinusoid, table };
   Kind kind = Kind::none;
@@ -52,8 +53,12 @@ struct TimeWaveform {
   std::vector<double> times, factors;  ///< table: factor(t), linear in between
   /// The factor at time t [s]; 1 when t is not finite (steady).
   double factor(double time) const;
-  /// Reads a `waveform:` section (`type`, `amplitude`, `period`, `times`, `values`).
+  /// Reads a `waveform:` section (`type`, `amplitude`, `period`, `times`, `values`, `file`).
   static TimeWaveform read(const config::Section& section);
+  /// Parses CSV text of `time, factor` rows (`#` comments, blank lines and one header line
+  /// allowed) into times and factors; throws InputError naming `name`:line of a bad row.
+  static void parse_csv(const std::string& text, const std::string& name,
+                        std::vector<double>& times, std::vector<double>& factors);
 };
 
 /// One entry of `boundary:`; later entries override earlier ones at shared vertices.
