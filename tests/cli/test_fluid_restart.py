@@ -22,20 +22,12 @@ The linear solver is PETSc's own LU of the gathered matrix without a Krylov wrap
 2 ranks — two identical 2-rank runs of DFG 2D-2 with MUMPS LU differ by ~1e-15 relative from
 the 4th step on — so no restart could be."""
 
-import csv
-
-from cli_common import Runner, parse_arguments, read_json
+from cli_common import DETERMINISTIC_FLUID, Runner, parse_arguments, read_json, read_rows
 
 DFG = ["--set", "time.step=0.02", "--set", "benchmark.statistics_from=0.05", "--set",
        "output.vtk=false", "--set", "output.checkpoint_interval=5"]
 TUBE = ["--set", "output.checkpoint_interval=3"]
-DETERMINISTIC = ["--", "-fluid_ksp_type", "preonly", "-fluid_pc_type", "redundant",
-                 "-fluid_redundant_pc_type", "lu"]
-
-
-def rows(path):
-    with open(path) as f:
-        return list(csv.DictReader(f))
+DETERMINISTIC = ["--", *DETERMINISTIC_FLUID]
 
 
 def main():
@@ -51,8 +43,8 @@ def main():
     def same(name, straight, restarted, first_row):
         """The restarted run's series are the straight run's rows from first_row on, and the
         benchmarks are equal, bit for bit."""
-        reference = rows(work / straight / "series.csv")
-        again = rows(work / restarted / "series.csv")
+        reference = read_rows(work / straight / "series.csv")
+        again = read_rows(work / restarted / "series.csv")
         runner.expect(len(again) == len(reference) - first_row and again == reference[first_row:],
                       f"{name}, same ranks: the restarted rows are the straight run's bit for bit",
                       f"{len(again)} rows restarted, {len(reference)} straight")
@@ -73,7 +65,7 @@ def main():
     if runner.failures:
         runner.finish()
     same("DFG 2D-2", "straight", "again", 5)
-    reference = rows(work / "straight" / "series.csv")[-1]
+    reference = read_rows(work / "straight" / "series.csv")[-1]
     for ranks in (1, 3):
         result = run("dfg/2d2.yaml", f"again{ranks}", 0.2, *DFG, "--restart", work / "first",
                      ranks=ranks)
@@ -81,7 +73,7 @@ def main():
                       result.stdout[-3000:] + result.stderr)
         if result.returncode != 0:
             continue
-        last = rows(work / f"again{ranks}" / "series.csv")[-1]
+        last = read_rows(work / f"again{ranks}" / "series.csv")[-1]
         worst = max(abs(float(last[k]) / float(reference[k]) - 1)
                     for k in ("drag_coefficient", "lift_coefficient"))
         runner.expect(last["time"] == reference["time"] and worst < 1e-8,
@@ -98,8 +90,8 @@ def main():
         runner.expect(result.returncode == 0, f"tube {name} run succeeds",
                       result.stdout[-3000:] + result.stderr)
     if all(result.returncode == 0 for result in tube.values()):
-        reference = rows(work / "tube" / "series.csv")[3:]
-        again = rows(work / "tube-again" / "series.csv")
+        reference = read_rows(work / "tube" / "series.csv")[3:]
+        again = read_rows(work / "tube-again" / "series.csv")
         keys = ("outlet_pressure_outlet", "outlet_flow_outlet", "flow_inlet")
         worst = max((abs(float(a[k]) / float(b[k]) - 1) for a, b in zip(again, reference)
                      for k in keys), default=1.0)

@@ -13,7 +13,7 @@ plug inflow on the left, no-slip top and bottom, outflow on the right, 6 steps):
 import csv
 import io
 
-from cli_common import Runner, parse_arguments
+from cli_common import DETERMINISTIC_FLUID, Runner, parse_arguments
 
 CASE = """problem: navier_stokes
 mesh:
@@ -36,8 +36,7 @@ output:
   vtk: false
 """
 
-DETERMINISTIC = ["--", "-fluid_ksp_type", "preonly", "-fluid_pc_type", "redundant",
-                 "-fluid_redundant_pc_type", "lu"]
+DETERMINISTIC = ["--", *DETERMINISTIC_FLUID]
 TIMES = [0.0, 0.1, 0.2, 0.4]
 VALUES = [0.0, 1.0, 0.25, 0.5]
 

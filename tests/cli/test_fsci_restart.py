@@ -23,21 +23,13 @@ preonly, pc_type redundant; test_fluid_restart.py): the default MUMPS LU is not 
 reproducible on 2 ranks (two identical runs differ by ~1e-15 relative), so no restart could
 be."""
 
-import csv
-
-from cli_common import Runner, parse_arguments, read_json
+from cli_common import (DETERMINISTIC_FLUID, DETERMINISTIC_SOLID, Runner, parse_arguments,
+                        read_json, read_rows)
 
 VALVE = ["--set", "output.vtk=false", "--set", "fluid.outlets[0].waveform.times=[0,0.03,1]",
          "--set", "fluid.outlets[0].waveform.values=[0,-1.5,-1.5]",
          "--set", "output.checkpoint_interval=3"]
-DETERMINISTIC = ["--", "-fluid_ksp_type", "preonly", "-fluid_pc_type", "redundant",
-                 "-fluid_redundant_pc_type", "lu", "-solid_pc_type", "redundant",
-                 "-solid_redundant_pc_type", "lu"]
-
-
-def rows(path):
-    with open(path) as f:
-        return list(csv.DictReader(f))
+DETERMINISTIC = ["--", *DETERMINISTIC_FLUID, *DETERMINISTIC_SOLID]
 
 
 def main():
@@ -63,8 +55,8 @@ def main():
           f"constrained fluid nodes restored, complementarity constant "
           f"{state['solid0_contact']['complementarity_constant']:.4g}")
     runner.expect(sum(state["iqn_columns"]) > 0, "the checkpoint holds IQN-ILS columns to reuse")
-    reference = rows(work / "straight" / "series.csv")
-    again = rows(work / "again" / "series.csv")
+    reference = read_rows(work / "straight" / "series.csv")
+    again = read_rows(work / "again" / "series.csv")
     runner.expect(len(reference) == 6 and again == reference[3:],
                   "same ranks: steps 4..6 bit for bit as the straight run",
                   f"{len(again)} rows restarted, {len(reference)} straight\n"
@@ -78,7 +70,7 @@ def main():
     runner.expect(result.returncode == 0, "restart on 1 rank succeeds",
                   result.stdout[-3000:] + result.stderr)
     if result.returncode == 0:
-        last, expected = rows(work / "again1" / "series.csv")[-1], reference[-1]
+        last, expected = read_rows(work / "again1" / "series.csv")[-1], reference[-1]
         worst = max(abs(float(last[k]) / float(expected[k]) - 1)
                     for k in ("opening_leaflets", "outlet_flow_inlet"))
         runner.expect(last["time"] == expected["time"] and worst < 1e-5,
@@ -98,8 +90,8 @@ def main():
     runner.expect(all(result.returncode == 0 for result in results), "moving rigid body runs succeed",
                   "\n".join(result.stderr[-2000:] for result in results))
     if all(result.returncode == 0 for result in results):
-        reference = rows(work / "rigid" / "series.csv")
-        again = rows(work / "rigid-again" / "series.csv")
+        reference = read_rows(work / "rigid" / "series.csv")
+        again = read_rows(work / "rigid-again" / "series.csv")
         runner.expect(len(again) == 2 and again == reference[-2:],
                       "moving rigid body: steps 3..4 bit for bit as the straight run")
         runner.expect(reference[-1]["constrained_cylinder"] != reference[-3]["constrained_cylinder"],

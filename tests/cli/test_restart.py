@@ -14,16 +14,9 @@ Newmark free vibration (cases/solid/vibration.yaml, 40 steps):
 - a missing checkpoint folder, a checkpoint of another mesh and a quasi-static case are refused
   with one error line naming the folder, exit 2."""
 
-import csv
-
-from cli_common import Runner, parse_arguments, read_json
+from cli_common import Runner, parse_arguments, read_json, read_rows
 
 CASE = "solid/vibration.yaml"
-
-
-def rows(path):
-    with open(path) as f:
-        return list(csv.DictReader(f))
 
 
 def main():
@@ -46,8 +39,8 @@ def main():
         runner.finish()
     runner.expect((work / "first" / "checkpoint" / "state.json").exists(),
                   "the first run wrote a checkpoint")
-    reference = {row["step"]: row for row in rows(work / "straight" / "series.csv")}
-    restarted = rows(work / "again" / "series.csv")
+    reference = {row["step"]: row for row in read_rows(work / "straight" / "series.csv")}
+    restarted = read_rows(work / "again" / "series.csv")
     runner.expect([row["step"] for row in restarted] == [str(k) for k in range(21, 41)],
                   "the restarted series holds steps 21..40",
                   str([row["step"] for row in restarted]))
@@ -64,7 +57,7 @@ def main():
                       result.stdout + result.stderr)
         if result.returncode != 0:
             continue
-        last = rows(work / f"again{ranks}" / "series.csv")[-1]
+        last = read_rows(work / f"again{ranks}" / "series.csv")[-1]
         worst = 0.0
         for key in ("tip_displacement_y", "kinetic_energy", "total_energy"):
             a, b = float(last[key]), float(reference["40"][key])
@@ -84,8 +77,8 @@ def main():
     runner.expect(all(result.returncode == 0 for result in results), "ball in a box runs succeed",
                   "\n".join(result.stderr for result in results))
     if all(result.returncode == 0 for result in results):
-        reference = rows(work / "ball" / "series.csv")
-        restarted = rows(work / "ball-again" / "series.csv")
+        reference = read_rows(work / "ball" / "series.csv")
+        restarted = read_rows(work / "ball-again" / "series.csv")
         runner.expect(int(float(reference[260]["contact_active_nodes"])) > 0,
                       "the ball is in contact at the checkpoint (step 260)")
         runner.expect(restarted == reference[261:],
