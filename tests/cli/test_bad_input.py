@@ -41,6 +41,9 @@ def main():
                        ["--set mesh.cells=[4, x]", "mesh.cells"])
     expect_input_error("--set on an unknown key", ["check", cases / "poisson" / "mms2d.yaml", "--set", "mesh.size_x=1"],
                        ["mesh.size_x", "unknown key"])
+    expect_input_error("a 3D-only benchmark key in 2D",
+                       ["run", cases / "dfg" / "2d1.yaml", "--output", work / "o2", "--set", "benchmark.height=0.41"],
+                       ["benchmark.height", "3D"])
     unknown_problem = write(work / "unknown_problem.yaml", "problem: poison\n")
     expect_input_error("unknown problem", ["check", unknown_problem], ["unknown_problem.yaml:1", "problem", "poison"])
 

@@ -37,6 +37,7 @@ struct Benchmark {
   // is the span H of a 3D body
   std::string body;
   double mean_velocity = 1, diameter = 1, height = 1;
+  std::string height_given;  ///< where the case sets benchmark.height ("" when it does not)
   std::vector<double> pressure_points;  ///< x_A, y_A, x_B, y_B: Δp = p(A) − p(B)
   double reference_drag = 0, reference_lift = 0, reference_pressure_difference = 0;
   double statistics_from = 0;  ///< [s]
@@ -88,6 +89,7 @@ Parameters read(const config::Section& root) {
           benchmark.require<double>("diameter", {"m", "D of c = 2F/(ρŪ²D)", Bounds::positive()});
       b.height = benchmark.get<double>(
           "height", 1.0, {"m", "3D: the span H in c = 2F/(ρŪ²DH)", Bounds::positive()});
+      if (benchmark.has("height")) b.height_given = benchmark.located("height");
     }
     b.pressure_points = benchmark.get<std::vector<double>>(
         "pressure_points", {}, {"m", "x_A, y_A, x_B, y_B: Δp = p(A) − p(B) (steady runs)"});
@@ -145,6 +147,9 @@ class FlowProblem final : public run::Problem {
     }
     if ((b.type == "cavity" || !b.pressure_points.empty()) && dim != 2)
       throw InputError("benchmark: the cavity profiles and pressure probes are 2D quantities");
+    if (!b.height_given.empty() && dim != 3)
+      throw InputError(fmt::format(
+          "{}: the span H is for 3D bodies (2D coefficients are per unit depth)", b.height_given));
   }
 
   void describe() const override {
