@@ -44,6 +44,10 @@ def main():
     expect_input_error("a 3D-only benchmark key in 2D",
                        ["run", cases / "dfg" / "2d1.yaml", "--output", work / "o2", "--set", "benchmark.height=0.41"],
                        ["benchmark.height", "3D"])
+    expect_input_error("a per-solid checkpoint interval in a coupled case",
+                       ["run", cases / "turek_hron" / "fsi1.yaml", "--output", work / "o3",
+                        "--set", "solids[0].output.checkpoint_interval=5"],
+                       ["solids[0].output.checkpoint_interval", "output.checkpoint_interval"])
     unknown_problem = write(work / "unknown_problem.yaml", "problem: poison\n")
     expect_input_error("unknown problem", ["check", unknown_problem], ["unknown_problem.yaml:1", "problem", "poison"])
 

@@ -109,6 +109,13 @@ Parameters read(const config::Section& root) {
           "velocity", {}, {"m/s", "rigid: translation velocity of the body (empty: at rest)"});
     } else {
       solid.section = std::make_unique<config::Section>(entry);
+      if (entry.has("output")) {
+        const auto output = entry.section("output", "what the run writes");
+        if (output.has("checkpoint_interval"))
+          output.fail("checkpoint_interval",
+                      "a coupled run checkpoints its whole state with the case's "
+                      "output.checkpoint_interval, not per solid");
+      }
       solid.contact = contact::read_solid_contact(entry);
       solid.contact_stabilized =
           entry.choice("scheme", solid.contact.enabled() ? "contact_stabilized_newmark" : "newmark",
