@@ -657,24 +657,43 @@ class FsciProblem final : public run::Problem {
     }
     writer.state()["iqn_columns"] = io::Json::array_of(counts);
     if (columns.empty()) return;
+    for_each_quasi_newton_field(
+        columns.size(), [&](std::size_t k, const Solid& solid, Vec packed, std::size_t offset) {
+          PetscScalar* values = nullptr;
+          COAPT_PETSC_CHECK(VecGetArray(packed, &values));
+          const int dim = solid.mesh.dim;
+          for (int v = 0; v < solid.mesh.n_owned_vertices; ++v)
+            for (std::size_t c = 0; c < columns.size(); ++c)
+              for (int i = 0; i < dim; ++i)
+                values[packed_index(v, c, i, dim, columns.size())] =
+                    (*columns[c])[offset + static_cast<std::size_t>(v) * dim + i];
+          COAPT_PETSC_CHECK(VecRestoreArray(packed, &values));
+          writer.add_vertex_field(fmt::format("solid{}_iqn", k), solid.mesh, packed,
+                                  static_cast<int>(columns.size()) * dim);
+        });
+  }
+
+  /// Entry (vertex v, column c, component i) of a packed IQN field with n_columns columns.
+  static std::size_t packed_index(int v, std::size_t c, int i, int dim, std::size_t n_columns) {
+    return (static_cast<std::size_t>(v) * n_columns + c) * static_cast<std::size_t>(dim) +
+           static_cast<std::size_t>(i);
+  }
+
+  /// visit(k, solid, packed, offset) for each deformable solid k: `packed` a vector of its
+  /// owned vertices with n_columns × dim values each, `offset` where the solid's entries start
+  /// in a column (the solids' owned dofs one after the other, as in quasi_newton.hpp).
+  template <class Visit>
+  void for_each_quasi_newton_field(std::size_t n_columns, Visit&& visit) const {
     std::size_t offset = 0;
     for (std::size_t k = 0; k < solids_.size(); ++k) {
       const auto& solid = *solids_[k];
       if (!solid.model) continue;
       const int dim = solid.mesh.dim, owned = solid.mesh.n_owned_vertices;
-      const int components = static_cast<int>(columns.size()) * dim;
       OwnedVec packed;
-      COAPT_PETSC_CHECK(VecCreateMPI(comm_, static_cast<PetscInt>(owned) * components,
-                                     PETSC_DETERMINE, packed.out()));
-      PetscScalar* values = nullptr;
-      COAPT_PETSC_CHECK(VecGetArray(packed, &values));
-      for (int v = 0; v < owned; ++v)
-        for (std::size_t c = 0; c < columns.size(); ++c)
-          for (int i = 0; i < dim; ++i)
-            values[static_cast<std::size_t>(v) * components + c * dim + i] =
-                (*columns[c])[offset + static_cast<std::size_t>(v) * dim + i];
-      COAPT_PETSC_CHECK(VecRestoreArray(packed, &values));
-      writer.add_vertex_field(fmt::format("solid{}_iqn", k), solid.mesh, packed, components);
+      COAPT_PETSC_CHECK(
+          VecCreateMPI(comm_, static_cast<PetscInt>(owned) * static_cast<PetscInt>(n_columns) * dim,
+                       PETSC_DETERMINE, packed.out()));
+      visit(k, solid, packed.get(), offset);
       offset += static_cast<std::size_t>(owned) * dim;
     }
   }
@@ -700,28 +719,21 @@ class FsciProblem final : public run::Problem {
         columns.push_back(&step.v[j]);
         columns.push_back(&step.w[j]);
       }
-    if (n_columns > 0) {
-      std::size_t offset = 0;
-      for (std::size_t k = 0; k < solids_.size(); ++k) {
-        const auto& solid = *solids_[k];
-        if (!solid.model) continue;
-        const int dim = solid.mesh.dim, owned = solid.mesh.n_owned_vertices;
-        const int components = static_cast<int>(columns.size()) * dim;
-        OwnedVec packed;
-        COAPT_PETSC_CHECK(VecCreateMPI(comm_, static_cast<PetscInt>(owned) * components,
-                                       PETSC_DETERMINE, packed.out()));
-        reader.read_vertex_field(fmt::format("solid{}_iqn", k), solid.mesh, packed, components);
-        const PetscScalar* values = nullptr;
-        COAPT_PETSC_CHECK(VecGetArrayRead(packed, &values));
-        for (int v = 0; v < owned; ++v)
-          for (std::size_t c = 0; c < columns.size(); ++c)
-            for (int i = 0; i < dim; ++i)
-              (*columns[c])[offset + static_cast<std::size_t>(v) * dim + i] =
-                  values[static_cast<std::size_t>(v) * components + c * dim + i];
-        COAPT_PETSC_CHECK(VecRestoreArrayRead(packed, &values));
-        offset += static_cast<std::size_t>(owned) * dim;
-      }
-    }
+    if (n_columns > 0)
+      for_each_quasi_newton_field(
+          columns.size(), [&](std::size_t k, const Solid& solid, Vec packed, std::size_t offset) {
+            const int dim = solid.mesh.dim;
+            reader.read_vertex_field(fmt::format("solid{}_iqn", k), solid.mesh, packed,
+                                     static_cast<int>(columns.size()) * dim);
+            const PetscScalar* values = nullptr;
+            COAPT_PETSC_CHECK(VecGetArrayRead(packed, &values));
+            for (int v = 0; v < solid.mesh.n_owned_vertices; ++v)
+              for (std::size_t c = 0; c < columns.size(); ++c)
+                for (int i = 0; i < dim; ++i)
+                  (*columns[c])[offset + static_cast<std::size_t>(v) * dim + i] =
+                      values[packed_index(v, c, i, dim, columns.size())];
+            COAPT_PETSC_CHECK(VecRestoreArrayRead(packed, &values));
+          });
     quasi_newton_->restore_reused(std::move(steps));
   }
 
