@@ -80,6 +80,9 @@ ContactConstraints::ContactConstraints(const ContactParameters& parameters, cons
     slave_gathers_.back()->gather(dirichlet_marker_, marker);
     state.dirichlet.assign(marker.size(), 0);
     for (std::size_t k = 0; k < marker.size(); ++k) state.dirichlet[k] = marker[k] > 0.5;
+    master_gathers_.back()->gather(dirichlet_marker_, marker);
+    state.master_dirichlet.assign(marker.size(), 0);
+    for (std::size_t k = 0; k < marker.size(); ++k) state.master_dirichlet[k] = marker[k] > 0.5;
     double size = 0;
     for (int f = 0; f < state.slave.n_facets(); ++f) {
       const auto a = facet_area_normal(state.slave, state.slave.reference, f);
@@ -112,6 +115,7 @@ void ContactConstraints::update(Vec u, Vec residual) {
     auto& pair = pairs_[p];
     current_positions(p, u, pair.slave_x, pair.master_x);
     slave_gathers_[p]->gather(residual, force);
+    pair.slave_residual = force;
     pair.mortar =
         assemble_mortar(pair.slave, pair.slave_x, pair.master, pair.master_x, mortar_options(p));
     const double tolerance = parameters_.relative_gap_tolerance * reference_sizes_[p];
@@ -135,9 +139,16 @@ void ContactConstraints::update(Vec u, Vec residual) {
       }
       const double pressure = -normal_force / m.dual_mass[j];
       const double gap = m.gap(j);
+      // An active node's own open gap does not count against it: with the frozen geometry the
+      // step that closes a gap leaves a small positive one behind, and c times it (c from the
+      // stiffness) can outweigh the node's pressure, releasing a node in compression and
+      // cycling. Such a node leaves when its pressure is tensile
+      // beyond c times any penetration. At convergence the gap rows hold g_j = 0 on A, so the
+      // converged set satisfies the same conditions as with the plain test.
+      const double open_gap = was_active ? std::min(gap - tolerance, 0.0) : gap - tolerance;
       const bool active = complementarity_constant_ > 0.0
-                              ? pressure - complementarity_constant_ * (gap - tolerance) > 0.0
-                              : (gap <= tolerance || pressure > 0.0);
+                              ? pressure - complementarity_constant_ * open_gap > 0.0
+                              : gap <= tolerance;
       pair.pressure[j] = pressure;
       pair.active[j] = active;
       status.changes += active != was_active ? 1 : 0;
@@ -164,6 +175,11 @@ void ContactConstraints::update(Vec u, Vec residual) {
   if (status_.active == 0) return;
   // R ← P R − c n g̃ on the active rows.
   COAPT_PETSC_CHECK(MatMult(row_operator_, residual, work_));
+  add_gap_terms(work_, -1.0);
+  COAPT_PETSC_CHECK(VecCopy(work_, residual));
+}
+
+void ContactConstraints::add_gap_terms(Vec v, double sign) {
   for (const auto& pair : pairs_)
     for (int j = 0; j < pair.slave.n_nodes(); ++j) {
       if (!pair.active[j]) continue;
@@ -172,15 +188,14 @@ void ContactConstraints::update(Vec u, Vec residual) {
         if (dof < first_dof_ || dof >= end_dof_ ||
             pair.dirichlet[static_cast<std::size_t>(j) * dim_ + i])
           continue;
-        const double value = -complementarity_constant_ *
+        const double value = sign * complementarity_constant_ *
                              pair.mortar.normals[static_cast<std::size_t>(j) * dim_ + i] *
                              pair.mortar.weighted_gap[j];
-        COAPT_PETSC_CHECK(VecSetValue(work_, dof, value, ADD_VALUES));
+        COAPT_PETSC_CHECK(VecSetValue(v, dof, value, ADD_VALUES));
       }
     }
-  COAPT_PETSC_CHECK(VecAssemblyBegin(work_));
-  COAPT_PETSC_CHECK(VecAssemblyEnd(work_));
-  COAPT_PETSC_CHECK(VecCopy(work_, residual));
+  COAPT_PETSC_CHECK(VecAssemblyBegin(v));
+  COAPT_PETSC_CHECK(VecAssemblyEnd(v));
 }
 
 void ContactConstraints::active_marker(std::size_t p, Vec marker) const {
@@ -351,8 +366,9 @@ void ContactConstraints::build_row_operator() {
 }
 
 Mat ContactConstraints::transform(Mat K, Vec rhs) {
-  if (status_.active == 0) return K;
-  if (!(complementarity_constant_ > 0.0)) {
+  // c is taken as soon as a slave node is constrained, active or not: the active-set test of
+  // the next update needs it (contact_constraints.hpp, update).
+  if (!(complementarity_constant_ > 0.0) && status_.constrained > 0) {
     // c from the stiffness: mean K_ii over the free dofs of constrained slave nodes over the
     // mean D_jj of those nodes, so the gap rows weigh like the equilibrium rows.
     OwnedVec diagonal;
@@ -380,14 +396,23 @@ Mat ContactConstraints::transform(Mat K, Vec rhs) {
       complementarity_constant_ = (stiffness / n_dofs) / (dual / n_nodes);
     status_.complementarity_constant = complementarity_constant_;
   }
-  // G = c Σ_{j∈A} E_j n_j n_jᵀ B_j on owned free rows.
+  if (status_.active == 0) return K;
+  // G = c Σ_{j∈A} E_j n_j n_jᵀ B_j on owned free rows (frozen geometry), or the derivative of
+  // the whole geometry-dependent part (finite_difference, add_geometric_tangent).
   std::vector<PetscInt> rows, columns;
   std::vector<double> values;
   const double c = complementarity_constant_;
   const auto prescribed = [&](PetscInt dof) {
     return std::binary_search(dirichlet_.begin(), dirichlet_.end(), dof);
   };
+  // The derivative is taken once the active set holds (no node changed at this update): while
+  // it is still being found, R is far from the contact forces it will balance and (dP/du) R
+  // points the search astray.
+  const bool geometric = parameters_.finite_difference_geometry && status_.changes == 0;
+  for (std::size_t p = 0; p < pairs_.size() && geometric; ++p)
+    add_geometric_tangent(p, rows, columns, values);
   for (const auto& pair : pairs_) {
+    if (geometric) break;
     const auto& m = pair.mortar;
     const auto add_row_block = [&](const MortarEntry& e, PetscInt column_vertex, double sign) {
       const double* n = m.normals.data() + static_cast<std::size_t>(e.row) * dim_;
@@ -412,25 +437,131 @@ Mat ContactConstraints::transform(Mat K, Vec rhs) {
   COAPT_PETSC_CHECK(
       MatMatMult(row_operator_, K, MAT_INITIAL_MATRIX, PETSC_DEFAULT, contact_matrix_.out()));
   COAPT_PETSC_CHECK(MatAXPY(contact_matrix_, 1.0, gap_rows_, DIFFERENT_NONZERO_PATTERN));
-  // rhs ← P rhs + c n g̃ on the active rows.
+  // rhs = −(P R − c n g̃) from update(), plus whatever the caller added after it (the lifting
+  // −K d of prescribed increments), which P has not seen. P is idempotent, but it does not
+  // annihilate c n g̃: its elimination part carries the normal rows of A onto the master rows
+  // (and other slave rows) as forces (M_jl / D_jj) c g̃_j n_j, which would push the master on
+  // by the slave's penetration. So the gap terms are taken out before P and put back after:
+  // rhs ← P (rhs − c n g̃) + c n g̃.
+  add_gap_terms(rhs, -1.0);
   COAPT_PETSC_CHECK(MatMult(row_operator_, rhs, work_));
-  for (const auto& pair : pairs_)
-    for (int j = 0; j < pair.slave.n_nodes(); ++j) {
-      if (!pair.active[j]) continue;
-      for (int i = 0; i < dim_; ++i) {
-        const PetscInt dof = pair.slave.global_vertex[j] * dim_ + i;
-        if (dof < first_dof_ || dof >= end_dof_ || prescribed(dof)) continue;
-        COAPT_PETSC_CHECK(
-            VecSetValue(work_, dof,
-                        c * pair.mortar.normals[static_cast<std::size_t>(j) * dim_ + i] *
-                            pair.mortar.weighted_gap[j],
-                        ADD_VALUES));
-      }
-    }
-  COAPT_PETSC_CHECK(VecAssemblyBegin(work_));
-  COAPT_PETSC_CHECK(VecAssemblyEnd(work_));
+  add_gap_terms(work_, 1.0);
   COAPT_PETSC_CHECK(VecCopy(work_, rhs));
   return contact_matrix_;
+}
+
+void ContactConstraints::contact_terms(std::size_t p, std::span<const double> slave_x,
+                                       std::span<const double> master_x,
+                                       std::vector<double>& slave_terms,
+                                       std::vector<double>& master_terms) const {
+  const auto& pair = pairs_[p];
+  const auto m = assemble_mortar(pair.slave, slave_x, pair.master, master_x, mortar_options(p));
+  slave_terms.assign(slave_x.size(), 0.0);
+  master_terms.assign(master_x.size(), 0.0);
+  const double c = complementarity_constant_;
+  std::vector<double> row_normal_force(static_cast<std::size_t>(pair.slave.n_nodes()), 0.0);
+  for (int j = 0; j < pair.slave.n_nodes(); ++j) {
+    if (!pair.active[j] || !(m.dual_mass[j] > 0.0)) continue;
+    const double* n = m.normals.data() + static_cast<std::size_t>(j) * dim_;
+    double q = 0.0;  // n_j · R_j over the free components
+    for (int i = 0; i < dim_; ++i) {
+      const std::size_t k = static_cast<std::size_t>(j) * dim_ + i;
+      if (!pair.dirichlet[k]) q += n[i] * pair.slave_residual[k];
+    }
+    row_normal_force[static_cast<std::size_t>(j)] = q;
+    for (int i = 0; i < dim_; ++i)
+      slave_terms[static_cast<std::size_t>(j) * dim_ + i] -= n[i] * (q + c * m.weighted_gap[j]);
+  }
+  // (S_k n_j)_a with S_k = I − n_k n_kᵀ when slave node k is active.
+  const auto projected = [&](int k, const double* n, int a) {
+    if (!pair.active[k]) return n[a];
+    const double* s = m.normals.data() + static_cast<std::size_t>(k) * dim_;
+    double sn = 0.0;
+    for (int i = 0; i < dim_; ++i) sn += s[i] * n[i];
+    return n[a] - s[a] * sn;
+  };
+  for (const auto& e : m.slave_coupling) {
+    if (!pair.active[e.row] || e.column == e.row || !(m.dual_mass[e.row] > 0.0)) continue;
+    const double* n = m.normals.data() + static_cast<std::size_t>(e.row) * dim_;
+    const double f = -e.value / m.dual_mass[e.row] * row_normal_force[e.row];
+    for (int a = 0; a < dim_; ++a)
+      slave_terms[static_cast<std::size_t>(e.column) * dim_ + a] += f * projected(e.column, n, a);
+  }
+  for (const auto& e : m.master_coupling) {
+    if (!pair.active[e.row] || !(m.dual_mass[e.row] > 0.0)) continue;
+    const double* n = m.normals.data() + static_cast<std::size_t>(e.row) * dim_;
+    const double f = e.value / m.dual_mass[e.row] * row_normal_force[e.row];
+    for (int a = 0; a < dim_; ++a)
+      master_terms[static_cast<std::size_t>(e.column) * dim_ + a] += f * n[a];
+  }
+}
+
+void ContactConstraints::add_geometric_tangent(std::size_t p, std::vector<PetscInt>& rows,
+                                               std::vector<PetscInt>& columns,
+                                               std::vector<double>& values) const {
+  const auto& pair = pairs_[p];
+  const auto& m = pair.mortar;
+  // The nodes whose positions the terms depend on: the slave facets around the active nodes
+  // and their coupled slave nodes (normals, dual basis, projections), the coupled master nodes.
+  std::vector<char> slave_moves(static_cast<std::size_t>(pair.slave.n_nodes()), 0);
+  std::vector<char> master_moves(static_cast<std::size_t>(pair.master.n_nodes()), 0);
+  for (const auto& e : m.slave_coupling)
+    if (pair.active[e.row]) slave_moves[e.column] = 1;
+  for (const auto& e : m.master_coupling)
+    if (pair.active[e.row]) master_moves[e.column] = 1;
+  std::vector<char> around(slave_moves);
+  for (int f = 0; f < pair.slave.n_facets(); ++f) {
+    const auto facet = pair.slave.facet(f);
+    bool touches = false;
+    for (int node : facet) touches = touches || around[node] != 0;
+    if (touches)
+      for (int node : facet) slave_moves[node] = 1;
+  }
+  const auto prescribed = [&](PetscInt dof) {
+    return std::binary_search(dirichlet_.begin(), dirichlet_.end(), dof);
+  };
+  // Central differences of the terms over each free coordinate that moves.
+  const double step = 1e-7 * reference_sizes_[p];
+  std::vector<double> slave_x = pair.slave_x, master_x = pair.master_x;
+  std::vector<double> plus_s, plus_m, minus_s, minus_m;
+  const auto emit = [&](PetscInt column) {
+    const auto add = [&](const Surface& surface, const std::vector<double>& plus,
+                         const std::vector<double>& minus) {
+      for (int node = 0; node < surface.n_nodes(); ++node)
+        for (int a = 0; a < dim_; ++a) {
+          const std::size_t k = static_cast<std::size_t>(node) * dim_ + a;
+          const double derivative = (plus[k] - minus[k]) / (2.0 * step);
+          if (derivative == 0.0) continue;
+          const PetscInt row = surface.global_vertex[node] * dim_ + a;
+          if (row < first_dof_ || row >= end_dof_ || prescribed(row)) continue;
+          rows.push_back(row);
+          columns.push_back(column);
+          values.push_back(derivative);
+        }
+    };
+    add(pair.slave, plus_s, minus_s);
+    add(pair.master, plus_m, minus_m);
+  };
+  const auto differentiate = [&](std::vector<double>& x, std::size_t k, PetscInt column) {
+    const double x0 = x[k];
+    x[k] = x0 + step;
+    contact_terms(p, slave_x, master_x, plus_s, plus_m);
+    x[k] = x0 - step;
+    contact_terms(p, slave_x, master_x, minus_s, minus_m);
+    x[k] = x0;
+    emit(column);
+  };
+  for (int node = 0; node < pair.slave.n_nodes(); ++node)
+    for (int b = 0; b < dim_ && slave_moves[node]; ++b) {
+      const std::size_t k = static_cast<std::size_t>(node) * dim_ + b;
+      if (!pair.dirichlet[k]) differentiate(slave_x, k, pair.slave.global_vertex[node] * dim_ + b);
+    }
+  for (int node = 0; node < pair.master.n_nodes(); ++node)
+    for (int b = 0; b < dim_ && master_moves[node]; ++b) {
+      const std::size_t k = static_cast<std::size_t>(node) * dim_ + b;
+      if (!pair.master_dirichlet[k])
+        differentiate(master_x, k, pair.master.global_vertex[node] * dim_ + b);
+    }
 }
 
 void ContactConstraints::vertex_fields(std::vector<double>& pressure, std::vector<double>& gap,

@@ -12,7 +12,11 @@
 ///   p_j ≥ 0,  g_j = g̃_j / D_jj ≥ 0,  p_j g_j = 0  ⇔  C_j = p_j − max(0, p_j − c g_j) = 0.
 /// Because D̂_jk = δ_jk D_jj on a constrained node, its own equation gives its multiplier:
 ///   p_j = −n_j · R_j / D_jj   (R_j: the residual of node j, no contact force in it).
-/// Active set A = {j constrained : p_j − c (g_j − tol) > 0}. On A, the node's normal equation
+/// Active set A = {j constrained : p_j − c (g_j − tol) > 0}, where a node already in A counts
+/// only a negative g_j − tol (its open gap is the round-off of the unlinearised geometry, see
+/// update()); before c is known (the first update of a run, before any stiffness was seen)
+/// A = {g_j ≤ tol}: away from equilibrium p_j is the out-of-balance force, whose sign says
+/// nothing about an open node. On A, the node's normal equation
 /// is replaced by the linearised gap condition g̃_j(u + Δu) ≈ g̃_j − n_jᵀ B_j Δu = 0, its
 /// tangential equations stay (frictionless: λ_t = 0), and its multiplier is eliminated from
 /// the other rows: with the row operator
@@ -77,7 +81,9 @@ struct PairState {
   MortarOperators mortar;
   std::vector<double> pressure;  ///< p_j [Pa] (0 off the constrained nodes)
   std::vector<char> active;
-  std::vector<char> dirichlet;  ///< per slave dof (n × dim): prescribed
+  std::vector<char> dirichlet;         ///< per slave dof (n × dim): prescribed
+  std::vector<char> master_dirichlet;  ///< per master dof (n × dim): prescribed
+  std::vector<double> slave_residual;  ///< R at the slave dofs at the last update (n × dim)
 };
 
 /// The contact constraints of a solid (see the file comment).
@@ -115,7 +121,8 @@ class ContactConstraints {
   /// Takes pair p's active set back from such a marker: the next update counts its changes
   /// against it. Collective.
   void restore_active(std::size_t p, Vec marker);
-  /// c [Pa/m] in use (0: computed at the next transform from the stiffness).
+  /// c [Pa/m] in use (0: computed from the stiffness at the next transform that finds a
+  /// constrained node).
   double complementarity_constant() const { return complementarity_constant_; }
   void set_complementarity_constant(double c) {
     complementarity_constant_ = c;
@@ -133,6 +140,18 @@ class ContactConstraints {
 
  private:
   void build_row_operator();
+  /// v ← v + sign c n_j g̃_j at the free dofs of the active slave nodes (owned). Collective.
+  void add_gap_terms(Vec v, double sign);
+  /// The geometry-dependent part of pair p's transformed residual, P R − R − c n g̃ (R the
+  /// residual at the last update, the active set frozen), at surface coordinates slave_x,
+  /// master_x: per slave and master dof (n × dim). Serial.
+  void contact_terms(std::size_t p, std::span<const double> slave_x,
+                     std::span<const double> master_x, std::vector<double>& slave_terms,
+                     std::vector<double>& master_terms) const;
+  /// Its derivative by central differences of the surface coordinates that enter it, as
+  /// matrix triplets on this rank's free rows (the finite_difference linearisation). Serial.
+  void add_geometric_tangent(std::size_t p, std::vector<PetscInt>& rows,
+                             std::vector<PetscInt>& columns, std::vector<double>& values) const;
   /// The current coordinates X + u of pair p's slave and master nodes (n × dim). Collective.
   void current_positions(std::size_t p, Vec u, std::vector<double>& slave_x,
                          std::vector<double>& master_x) const;

@@ -49,6 +49,13 @@ ContactParameters ContactParameters::read(const config::Section& root) {
       section.get<int>("max_active_set_changes", 30,
                        {"", "Newton iterations of a step in which the active set may still change",
                         Bounds::closed(1, 1000)});
+  p.finite_difference_geometry =
+      section.choice("linearisation", "frozen", {"frozen", "finite_difference"},
+                     {"",
+                      "the contact rows' Newton tangent: frozen (the mortar geometry held at "
+                      "the iterate: linear convergence where the contact zone rotates or "
+                      "slides) or finite_difference (its derivative by central differences of "
+                      "the surface nodes' positions)"}) == "finite_difference";
   return p;
 }
 

@@ -15,6 +15,10 @@
 ///     boundary_modification: true         no multipliers on the slave surface's boundary
 ///     max_active_set_changes: 30          Newton iterations in which the active set may
 ///                                         still change (then the step fails: cycling)
+///     linearisation: frozen               the Newton tangent of the contact rows: frozen
+///                                         (normals and mortar integrals held at the iterate)
+///                                         or finite_difference (their derivative too; see
+///                                         contact_constraints.hpp)
 ///
 /// A slave surface is usually the finer and the more curved of the two. A node may be a slave
 /// node of one pair only.
@@ -42,7 +46,8 @@ struct ContactParameters {
   double coverage_threshold = 1.0 - 1e-8;  ///< (0, 1]
   bool boundary_modification = true;
   int max_active_set_changes = 30;
-  std::string where;  ///< location of the section
+  bool finite_difference_geometry = false;  ///< linearisation: finite_difference
+  std::string where;                        ///< location of the section
 
   bool enabled() const { return !pairs.empty(); }
   /// Reads `contact:` from the case root (absent: no contact). InputError at the key.
