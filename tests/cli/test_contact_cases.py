@@ -60,12 +60,14 @@ def main():
             runner.expect(results[1]["contact_active_nodes"] == results[2]["contact_active_nodes"],
                           f"{case}: same active set on 1 and 2 ranks")
 
-    # Hertz on the coarse level: errors below bounds about 1.5x those measured when written
-    # (level 0: cylinder 1.3 % / 0.05 %, sphere 11.2 % / 4.8 %; finer levels in the docs),
-    # 1 and 2 ranks agree.
-    hertz = [("hertz/cylinder.yaml", "contact_half_width", 0.02, 0.01),
-             ("hertz/sphere.yaml", "contact_radius", 0.17, 0.075)]
-    for case, size, pressure_bound, size_bound in hertz:
+    # Hertz on the coarse level: the errors against Johnson's values below bounds about 1.5x
+    # those measured at level 0 when written (max pressure per current area / nominal max
+    # pressure / contact size: cylinder 1.25 % / 0.01 % / 0.05 %, sphere 6.4 % / 2.8 % /
+    # 0.9 %; finer levels in the docs; the cylinder's nominal bound is 0.5 %, what its finer
+    # levels reach), 1 and 2 ranks agree.
+    hertz = [("hertz/cylinder.yaml", "contact_half_width", 0.02, 0.005, 0.01),
+             ("hertz/sphere.yaml", "contact_radius", 0.095, 0.045, 0.014)]
+    for case, size, pressure_bound, nominal_bound, size_bound in hertz:
         results = {}
         for ranks in [1, 2]:
             name = case.replace("/", "_").replace(".yaml", "")
@@ -74,17 +76,21 @@ def main():
                 continue
             results[ranks] = b
             print(f"{case} np {ranks}: max_pressure {b['max_pressure']:.6e} (analytic "
-                  f"{b['max_pressure_analytic']:.6e}, error {b['max_pressure_error']:.3e}), {size} "
-                  f"{b[size]:.6e} (analytic {b[size + '_analytic']:.6e}, error "
-                  f"{b[size + '_error']:.3e})")
+                  f"{b['max_pressure_analytic']:.6e}, error {b['max_pressure_error']:.3e}), "
+                  f"max_nominal_pressure {b['max_nominal_pressure']:.6e} (error "
+                  f"{b['max_nominal_pressure_error']:.3e}), {size} {b[size]:.6e} (analytic "
+                  f"{b[size + '_analytic']:.6e}, error {b[size + '_error']:.3e})")
             runner.expect(b["max_pressure_error"] < pressure_bound,
-                          f"{case}: max pressure within {pressure_bound:.0%}")
+                          f"{case}: max pressure within {pressure_bound:.1%}")
+            runner.expect(b["max_nominal_pressure_error"] < nominal_bound,
+                          f"{case}: max nominal pressure within {nominal_bound:.1%}")
             runner.expect(b[size + "_error"] < size_bound, f"{case}: {size} within {size_bound:.1%}")
             check_complementarity(runner, f"{case} np {ranks}", b)
         if len(results) == 2:
-            difference = abs(results[1]["max_pressure"] - results[2]["max_pressure"])
-            runner.expect(difference <= 1e-6 * results[1]["max_pressure"],
-                          f"{case}: 1 and 2 ranks agree (max pressure differs by {difference:.3e})")
+            for key in ["max_pressure", "max_nominal_pressure"]:
+                difference = abs(results[1][key] - results[2][key])
+                runner.expect(difference <= 1e-6 * results[1][key],
+                              f"{case}: 1 and 2 ranks agree ({key} differs by {difference:.3e})")
 
     # Bad input: an unknown contact group is named with its key.
     result = runner.run("run", runner.source / "cases" / "contact" / "patch2d.yaml", "--output",

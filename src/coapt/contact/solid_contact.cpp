@@ -73,12 +73,31 @@ double HertzParameters::contact_size() const {
   return std::cbrt(3.0 * load * radius / (4.0 * E));
 }
 
+std::vector<double> nominal_pressures(const PairState& pair) {
+  const auto& slave = pair.slave;
+  std::vector<double> reference_area(static_cast<std::size_t>(slave.n_nodes()), 0.0);
+  for (int f = 0; f < slave.n_facets(); ++f) {
+    const auto area_normal = facet_area_normal(slave, slave.reference, f);
+    const double share =
+        std::sqrt(area_normal[0] * area_normal[0] + area_normal[1] * area_normal[1] +
+                  area_normal[2] * area_normal[2]) /
+        slave.dim;
+    for (const int node : slave.facet(f)) reference_area[static_cast<std::size_t>(node)] += share;
+  }
+  std::vector<double> nominal(reference_area.size(), 0.0);
+  for (std::size_t j = 0; j < nominal.size(); ++j)
+    if (pair.pressure[j] != 0.0 && reference_area[j] > 0.0)
+      nominal[j] = pair.pressure[j] * pair.mortar.dual_mass[j] / reference_area[j];
+  return nominal;
+}
+
 HertzMeasurement measure_hertz(const ContactConstraints& constraints, bool sphere) {
   HertzMeasurement m;
   // Least squares of p² = A − B r² over the active nodes: b = √(A/B), p₀ = √A.
   double s1 = 0, sx = 0, sxx = 0, sy = 0, sxy = 0;
   for (const auto& pair : constraints.pairs()) {
     const int dim = pair.slave.dim;
+    const auto nominal = nominal_pressures(pair);
     for (int j = 0; j < pair.slave.n_nodes(); ++j) {
       if (!pair.active[j]) continue;
       const double* x = pair.slave.reference.data() + static_cast<std::size_t>(j) * dim;
@@ -86,6 +105,8 @@ HertzMeasurement measure_hertz(const ContactConstraints& constraints, bool spher
       const double p = pair.pressure[j];
       ++m.active_nodes;
       m.max_pressure = std::max(m.max_pressure, p);
+      m.max_nominal_pressure =
+          std::max(m.max_nominal_pressure, nominal[static_cast<std::size_t>(j)]);
       m.outermost_active = std::max(m.outermost_active, r);
       const double X = r * r, Y = p * p;
       s1 += 1;
@@ -299,15 +320,18 @@ void ContactHook::write_nodes(const std::filesystem::path& file, MPI_Comm comm) 
   std::ofstream out(file);
   if (!out) throw Error(fmt::format("cannot write {}", file.string()));
   const int dim = constraints_.pairs().empty() ? 0 : constraints_.pairs().front().slave.dim;
-  out << "pair,x,y" << (dim == 3 ? ",z" : "") << ",pressure,gap,active,constrained\n";
+  out << "pair,x,y" << (dim == 3 ? ",z" : "")
+      << ",pressure,gap,active,constrained,nominal_pressure\n";
   for (std::size_t p = 0; p < constraints_.pairs().size(); ++p) {
     const auto& pair = constraints_.pairs()[p];
+    const auto nominal = nominal_pressures(pair);
     for (int j = 0; j < pair.slave.n_nodes(); ++j) {
       out << p;
       for (int i = 0; i < dim; ++i)
         out << fmt::format(",{:.17g}", pair.slave.reference[static_cast<std::size_t>(j) * dim + i]);
-      out << fmt::format(",{:.17g},{:.17g},{},{}\n", pair.pressure[j], pair.mortar.gap(j),
-                         int(pair.active[j]), int(pair.mortar.constrained(j)));
+      out << fmt::format(",{:.17g},{:.17g},{},{},{:.17g}\n", pair.pressure[j], pair.mortar.gap(j),
+                         int(pair.active[j]), int(pair.mortar.constrained(j)),
+                         nominal[static_cast<std::size_t>(j)]);
     }
   }
 }

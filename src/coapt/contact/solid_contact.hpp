@@ -70,9 +70,19 @@ struct PatchTestParameters {
 /// uniform Cauchy pressure that carries the load over the current contact surface).
 double pressure_error(const ContactConstraints& constraints, double force);
 
+/// The nominal contact pressure of each slave node of `pair`: its contact force p_j D_jj (the
+/// mortar operators are integrated on the current surface, so p_j is a force per current
+/// area) divided by its reference lumped area ∫_Γs(X) N_j (the node's share of the areas, or
+/// lengths in 2D, of its facets at the reference coordinates). The force per undeformed area
+/// (a first Piola–Kirchhoff traction) is the pressure of geometrically linear theory, which
+/// does not tell the two configurations apart; p_j itself is the Cauchy pressure. 0 where
+/// p_j is 0 or the node has no facet. Serial.
+std::vector<double> nominal_pressures(const PairState& pair);
+
 /// Measured Hertz figures from the slave pressures.
 struct HertzMeasurement {
-  double max_pressure = 0.0;  ///< largest nodal pressure [Pa]
+  double max_pressure = 0.0;          ///< largest nodal pressure p_j [Pa]
+  double max_nominal_pressure = 0.0;  ///< largest nominal pressure (nominal_pressures) [Pa]
   double contact_size = 0.0;  ///< b or a from the fit p² = p₀² (1 − r²/b²) over the active nodes
   double fitted_pressure = 0.0;   ///< p₀ of that fit [Pa]
   double outermost_active = 0.0;  ///< largest r of an active node [m]
@@ -107,7 +117,8 @@ class ContactHook final : public solid::NewtonHook {
   /// followed by `suffix` (e.g. "_leaflets" when several solids have contact).
   void add_series(run::RunOutput& output, const std::string& suffix = "") const;
   /// Writes every slave node of every pair as a CSV row (pair, reference coordinates,
-  /// pressure [Pa], gap [m], active, constrained) to `file`, on rank 0 only. Collective.
+  /// pressure [Pa], gap [m], active, constrained, nominal pressure [Pa] of nominal_pressures)
+  /// to `file`, on rank 0 only. Collective.
   void write_nodes(const std::filesystem::path& file, MPI_Comm comm) const;
   /// Logs the contact state after a step.
   void log_status(const std::string& label) const;

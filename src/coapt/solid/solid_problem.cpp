@@ -257,14 +257,19 @@ class SolidProblem final : public run::Problem {
       return std::abs(value - reference) / reference;
     };
     benchmark["max_pressure_error"] = error(measured.max_pressure, hertz_.max_pressure());
+    benchmark["max_nominal_pressure"] = measured.max_nominal_pressure;
+    benchmark["max_nominal_pressure_error"] =
+        error(measured.max_nominal_pressure, hertz_.max_pressure());
     benchmark[size + "_error"] = error(measured.contact_size, hertz_.contact_size());
     log::info(
         "Hertz: max pressure {:.6e} Pa (analytic {:.6e}, error {:.3f} %), {} {:.6e} m "
-        "(analytic {:.6e}, error {:.3f} %), {} active nodes",
+        "(analytic {:.6e}, error {:.3f} %), {} active nodes; max nominal pressure {:.6e} Pa "
+        "(error {:.3f} %)",
         measured.max_pressure, hertz_.max_pressure(),
         100 * error(measured.max_pressure, hertz_.max_pressure()), size, measured.contact_size,
         hertz_.contact_size(), 100 * error(measured.contact_size, hertz_.contact_size()),
-        measured.active_nodes);
+        measured.active_nodes, measured.max_nominal_pressure,
+        100 * error(measured.max_nominal_pressure, hertz_.max_pressure()));
   }
 
   /// Newmark from the case's initial state; series.csv gets the probes and the energies
