@@ -59,10 +59,11 @@ Mesh unstructured_box(double x0, double y0, double z0, double x1, double y1, dou
 /// read_gmsh does (physical groups, tags, checks; original numbers are Gmsh's tags).
 /// `h` is the largest element size (Gmsh's Mesh.MeshSizeMax, replacing any the file sets):
 /// elements are at most about h everywhere, and smaller where the file asks for smaller
-/// sizes (characteristic lengths at points, size fields); the file's other options
-/// (Mesh.MeshSizeFactor, ...) apply. Mesh.ElementOrder must stay 1. A mesh the file already
-/// generated itself ("Mesh 2;") is discarded and redone at size h. `size_factor` multiplies
-/// every size after the cap h (Gmsh's Mesh.MeshSizeFactor): refinement levels pass the
+/// sizes (characteristic lengths at points, size fields); the file's other options apply,
+/// except Mesh.MeshSizeMax and Mesh.MeshSizeFactor, which are set here after the file is read.
+/// Mesh.ElementOrder must stay 1. A mesh the file already generated itself ("Mesh 2;") is
+/// discarded and redone at size h. `size_factor` multiplies every size after the cap h
+/// (Gmsh's Mesh.MeshSizeFactor, replacing any the file sets): refinement levels pass the
 /// level-0 h and 2^-level, so every size, local refinement included, halves per level.
 Mesh mesh_geo_file(const std::string& path, double h, double size_factor = 1.0);
 
