@@ -332,7 +332,8 @@ bool ConvexPolyhedron::clip(const HalfSpace<3>& half_space, double tolerance, in
       const int w = neighbors_[v][k];
       const double dw = distances_[w];
       if (dw >= 0.0) continue;
-      COAPT_ASSERT(n < buffer_size, "polyhedron clipping exceeded its size bound");
+      // (the size bound above; checked per clip below, per vertex in Debug builds)
+      COAPT_DEBUG_ASSERT(n < buffer_size, "polyhedron clipping exceeded its size bound");
       const double t = dv / (dv - dw);
       const Point<3>& x = positions_[v];
       const Point<3>& y = positions_[w];
@@ -347,18 +348,20 @@ bool ConvexPolyhedron::clip(const HalfSpace<3>& half_space, double tolerance, in
       ++n;
     }
   }
-  COAPT_ASSERT(kept + n - first_new <= max_vertices, "polyhedron clipping exceeded its size bound");
+  COAPT_ASSERT(n <= buffer_size && kept + n - first_new <= max_vertices,
+               "polyhedron clipping exceeded its size bound");
 
   // (3) link consecutive new vertices along each face
   for (int start = first_new; start < n; ++start) {
     int current = start;
     int slot = 0;
-    int steps = 0;
+    [[maybe_unused]] int steps = 0;
     do {
       const int next = neighbors_[current][slot];
       slot = kNextSlot[back_[current][slot]];
       current = next;
-      COAPT_ASSERT(++steps <= n, "polyhedron graph is inconsistent");
+      // (the walk ends: the graph is 3-regular with a consistent rotation, see above)
+      COAPT_DEBUG_ASSERT(++steps <= n, "polyhedron graph is inconsistent");
     } while (current < first_new);
     neighbors_[start][2] = current;
     back_[start][2] = 1;
@@ -388,8 +391,8 @@ void ConvexPolyhedron::for_each_fan_tetrahedron(Visit&& visit) const {
     visited[start] |= static_cast<unsigned char>(1u << slot);
     int current = neighbors_[start][slot];
     int back = back_[start][slot];
-    for (int steps = 0;; ++steps) {
-      COAPT_ASSERT(steps < n_vertices_, "polyhedron graph is inconsistent");
+    for ([[maybe_unused]] int steps = 0;; ++steps) {
+      COAPT_DEBUG_ASSERT(steps < n_vertices_, "polyhedron graph is inconsistent");  // as in clip()
       const int out = kNextSlot[back];
       visited[current] |= static_cast<unsigned char>(1u << out);
       const int next = neighbors_[current][out];
