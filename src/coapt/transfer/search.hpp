@@ -21,10 +21,10 @@
 ///    the box overlaps that do not intersect. The pairs are stored grouped by slave cell.
 ///  Stage 2 by advancing front (SearchOptions::front, what the operators use): no pair list
 ///    is made up front; sweep() walks the owned slave cells and, for each, the received
-///    master cells through their face neighbours, starting from the cells an earlier face
-///    neighbour of the slave cell overlaps, with the caller's test (the intersection kernel
-///    itself) deciding which cells the front crosses. Cells it cannot vouch for fall back to
-///    the grid (see sweep()).
+///    master cells through their face neighbours, starting from one of the cells an earlier
+///    face neighbour of the slave cell overlaps, with the caller's test (the intersection
+///    kernel itself) deciding which faces of which cells the front crosses. Cells it cannot
+///    vouch for fall back to the grid (see sweep()).
 ///
 /// Moving master (the solid moves through a fixed fluid mesh): the search is built with the
 /// master boxes inflated by `SearchOptions::margin`. While no master vertex has moved more
