@@ -53,3 +53,14 @@ namespace detail {
       throw ::coapt::InternalError(std::string(__FILE__) + ":" + std::to_string(__LINE__) + \
                                    ": internal error: " + (message));                       \
   } while (false)
+
+/// COAPT_ASSERT in builds without NDEBUG only: for an invariant that a proof guarantees, in
+/// the innermost loop of a kernel, where the check costs a measurable share of the time. The
+/// condition is not evaluated in a Release build (no side effects in it that the code needs).
+#ifdef NDEBUG
+#define COAPT_DEBUG_ASSERT(condition, message) \
+  do {                                         \
+  } while (false)
+#else
+#define COAPT_DEBUG_ASSERT(condition, message) COAPT_ASSERT(condition, message)
+#endif

@@ -209,6 +209,10 @@ int ConvexPolygon::quadrature(QuadraturePoint<2>* points) const {
 // cap face(s) on the plane with the right orientation. (4) The kept and the new vertices
 // are the vertices in use; the clipped ones are no longer referenced.
 //
+// Planes touched. planes_[v] has a bit per plane v lies on: the starting faces through v,
+// the plane of every labelled clip that classified v at distance 0, and for a new vertex the
+// clip's own plane and the planes both ends of its edge lie on (the edge lies in them).
+//
 // Invariants. The graph is 3-regular with a consistent rotation after every clip, for any
 // pattern of clipped vertices (step 3 pairs the two new vertices that bound each run of
 // kept vertices along each face), so the fan decomposition below always describes closed
@@ -259,6 +263,11 @@ void ConvexPolyhedron::assign_tetrahedron(const std::array<Point<3>, 4>& vertice
   in_use_[1] = 1;
   in_use_[2] = 2;
   in_use_[3] = 3;
+  // vertex v lies on every face but the one opposite it (1 and 2 swapped with the vertices)
+  planes_[0] = 0b1110;
+  planes_[1] = positive ? 0b1101 : 0b1011;
+  planes_[2] = positive ? 0b1011 : 0b1101;
+  planes_[3] = 0b0111;
   n_vertices_ = 4;
   n_made_ = 4;
   n_clips_ = 0;
@@ -280,14 +289,25 @@ std::array<int, 3> ConvexPolyhedron::neighbors(int v) const {
   return numbers;
 }
 
-bool ConvexPolyhedron::clip(const HalfSpace<3>& half_space, double tolerance) {
+unsigned ConvexPolyhedron::touched_planes() const {
+  unsigned touched = 0;
+  for (int u = 0; u < n_vertices_; ++u) touched |= planes_[in_use_[u]];
+  return touched;
+}
+
+bool ConvexPolyhedron::clip(const HalfSpace<3>& half_space, double tolerance, int label) {
   if (n_vertices_ == 0) return false;
+  COAPT_ASSERT(label >= -1 && label < 4, "a clipping plane label lies in [0, 4)");
+  const unsigned char plane = label < 0 ? 0 : static_cast<unsigned char>(1u << (4 + label));
   // (1) classify (as classify() above, through the list of vertices in use)
   bool any_inside = false, any_outside = false;
   for (int u = 0; u < n_vertices_; ++u) {
     const int v = in_use_[u];
     double d = half_space.distance(positions_[v]);
-    if (std::fabs(d) <= tolerance) d = 0.0;
+    if (std::fabs(d) <= tolerance) {
+      d = 0.0;
+      planes_[v] |= plane;
+    }
     distances_[v] = d;
     any_inside |= d > 0.0;
     any_outside |= d < 0.0;
@@ -312,7 +332,8 @@ bool ConvexPolyhedron::clip(const HalfSpace<3>& half_space, double tolerance) {
       const int w = neighbors_[v][k];
       const double dw = distances_[w];
       if (dw >= 0.0) continue;
-      COAPT_ASSERT(n < buffer_size, "polyhedron clipping exceeded its size bound");
+      // (the size bound above; checked per clip below, per vertex in Debug builds)
+      COAPT_DEBUG_ASSERT(n < buffer_size, "polyhedron clipping exceeded its size bound");
       const double t = dv / (dv - dw);
       const Point<3>& x = positions_[v];
       const Point<3>& y = positions_[w];
@@ -321,23 +342,26 @@ bool ConvexPolyhedron::clip(const HalfSpace<3>& half_space, double tolerance) {
       neighbors_[n][0] = v;
       back_[n][0] = k;
       distances_[n] = 0.0;
+      planes_[n] = static_cast<unsigned char>((planes_[v] & planes_[w]) | plane);
       neighbors_[v][k] = n;
       back_[v][k] = 0;
       ++n;
     }
   }
-  COAPT_ASSERT(kept + n - first_new <= max_vertices, "polyhedron clipping exceeded its size bound");
+  COAPT_ASSERT(n <= buffer_size && kept + n - first_new <= max_vertices,
+               "polyhedron clipping exceeded its size bound");
 
   // (3) link consecutive new vertices along each face
   for (int start = first_new; start < n; ++start) {
     int current = start;
     int slot = 0;
-    int steps = 0;
+    [[maybe_unused]] int steps = 0;
     do {
       const int next = neighbors_[current][slot];
       slot = kNextSlot[back_[current][slot]];
       current = next;
-      COAPT_ASSERT(++steps <= n, "polyhedron graph is inconsistent");
+      // (the walk ends: the graph is 3-regular with a consistent rotation, see above)
+      COAPT_DEBUG_ASSERT(++steps <= n, "polyhedron graph is inconsistent");
     } while (current < first_new);
     neighbors_[start][2] = current;
     back_[start][2] = 1;
@@ -367,8 +391,8 @@ void ConvexPolyhedron::for_each_fan_tetrahedron(Visit&& visit) const {
     visited[start] |= static_cast<unsigned char>(1u << slot);
     int current = neighbors_[start][slot];
     int back = back_[start][slot];
-    for (int steps = 0;; ++steps) {
-      COAPT_ASSERT(steps < n_vertices_, "polyhedron graph is inconsistent");
+    for ([[maybe_unused]] int steps = 0;; ++steps) {
+      COAPT_DEBUG_ASSERT(steps < n_vertices_, "polyhedron graph is inconsistent");  // as in clip()
       const int out = kNextSlot[back];
       visited[current] |= static_cast<unsigned char>(1u << out);
       const int next = neighbors_[current][out];

@@ -67,7 +67,8 @@ class ConvexPolygon {
 /// neighbours counter-clockwise seen from outside, and where it appears in each neighbour's
 /// list), made from a tetrahedron and clipped by at most four half-spaces. Clipped vertices
 /// stay in the buffer, unused: the vertices in use are a list of buffer slots, so a clip moves
-/// no vertex and renumbers no neighbour.
+/// no vertex and renumbers no neighbour. Each vertex also records which of the starting
+/// tetrahedron's faces and of the labelled clipping planes it lies on (touched_planes()).
 class ConvexPolyhedron {
  public:
   static constexpr int max_clips = 4;
@@ -81,8 +82,15 @@ class ConvexPolyhedron {
   /// Starts from the unit tetrahedron (0, e_1, e_2, e_3).
   void assign_unit_tetrahedron();
   /// Keeps the part with distance ≥ 0; |distance| ≤ tolerance counts as on the plane.
-  /// Returns false when nothing of positive volume is left (the polyhedron is then empty).
-  bool clip(const HalfSpace<3>& half_space, double tolerance);
+  /// `label` ∈ [0, 4) names the plane for touched_planes() (−1: not recorded). Returns false
+  /// when nothing of positive volume is left (the polyhedron is then empty).
+  bool clip(const HalfSpace<3>& half_space, double tolerance, int label = -1);
+  /// The planes some vertex in use lies on: bit i (i < 4) for the face of the starting
+  /// tetrahedron opposite its vertex i, bit 4 + l for the plane of a clip labelled l (on it:
+  /// |distance| ≤ tolerance in that clip, or made on an edge of two vertices on it). The
+  /// polyhedron lies on one side of each of these planes, so one whose bit is clear does not
+  /// meet it.
+  unsigned touched_planes() const;
   /// Number of vertices; vertex(v) and neighbors(v) number them 0 .. size() − 1.
   int size() const { return n_vertices_; }
   const Point<3>& vertex(int v) const { return positions_[in_use_[v]]; }
@@ -105,7 +113,8 @@ class ConvexPolyhedron {
   std::array<std::array<int, 3>, buffer_size> neighbors_{};
   // back_[v][k]: the slot of v in the neighbour list of neighbors_[v][k]
   std::array<std::array<int, 3>, buffer_size> back_{};
-  std::array<double, buffer_size> distances_{};  // scratch for clip()
+  std::array<double, buffer_size> distances_{};      // scratch for clip()
+  std::array<unsigned char, buffer_size> planes_{};  // the planes of touched_planes() it lies on
 };
 
 }  // namespace coapt::transfer

@@ -17,20 +17,25 @@ namespace coapt::transfer {
 //  3. β_jk = λ^L_j(s_k), the barycentric coordinates in L of the vertices of S. If for
 //     some j all β_jk ≤ tol, face plane j of L separates: empty. Planes with some
 //     β_jk < −tol cut S; if none does, S ⊂ L and A∩B = S.
-//  4. γ_ik = λ^S_i(l_k): a separating plane of S gives empty; all γ_ik ≥ −tol means
-//     L ⊂ S and A∩B = L.
+//  4. The vertices of L are not tested against the faces of S up front: L ⊂ S needs
+//     |L| ≤ |S|, so only S = L, which step 3 has found as S ⊂ L; and with an advancing
+//     front nearly every pair that gets this far overlaps. A separating face plane of S
+//     leaves nothing of the clipping of step 5, which then computes γ_ik = λ^S_i(l_k) to
+//     tell the pair separated (some face plane of S with all γ_ik ≤ tol) from touching.
 //  5. Otherwise clip S in its own reference coordinates ξ (x = s_0 + J ξ, S = the unit
 //     simplex) by the half-spaces {λ^L_j ≥ 0} of the cutting planes only, where
 //     λ^L_j(ξ) = β_j0 + Σ_k (β_jk − β_j0) ξ_k is known from step 3 (clipping.cpp). The
 //     planes that cut off more vertices of S (β_jk < −tol) go first, so that the later
 //     clips work on a small polytope (the result does not depend on the order, up to
-//     round-off).
+//     round-off). In 3D the clipped polytope also says which face planes of S and of L its
+//     vertices lie on (ConvexPolyhedron::touched_planes): the faces of B that A∩B touches,
+//     the only ones an advancing front has to cross (LocalIntegrals::crossed_faces_b).
 //  6. Moments of the clipped polytope in ξ (measure V_ξ, centroid ξ̄, central second
 //     moment C_ξ); with u = (1 − Σξ, ξ) = λ^S and its covariance C_u,
 //       ∫ λ^S_i λ^L_j = d!|S| Σ_k (V_ξ ū_i ū_k + C_u,ik) β_jk,
 //       ∫ λ^S_i = d!|S| V_ξ ū_i,  ∫ λ^L_j = d!|S| V_ξ Σ_k β_jk ū_k,
-//     exact for affine λ. When S ⊂ L or L ⊂ S the single-simplex formula
-//     ∫_T λ_k λ_l = |T| (1 + δ_kl) / ((d+1)(d+2)) gives them from β or γ directly.
+//     exact for affine λ. When S ⊂ L the single-simplex formula
+//     ∫_T λ_k λ_l = |T| (1 + δ_kl) / ((d+1)(d+2)) gives them from β directly.
 //  7. Measures ≤ kMeasureTolerance · min(|A|, |B|) are reported as empty; a measure above
 //     min(|A|, |B|) (round-off) is scaled back to it with all the integrals.
 //
@@ -60,15 +65,15 @@ constexpr double factorial(int n) {
 
 template <int dim>
 struct Overlap {
-  enum class Kind { empty, small_inside, large_inside, clipped };
+  enum class Kind { empty, small_inside, clipped };
   Kind kind = Kind::empty;
   bool separated = true;     ///< empty by the rejection tests (false: passed them)
   unsigned b_crossed = ~0u;  ///< bit j: a vertex of A has λ^B_j < −tol (all bits: not known)
+  unsigned b_touched = ~0u;  ///< bit j: A∩B may touch face j of B (clipped in 3D: it does)
   bool a_is_small = true;
   const Simplex<dim>* small = nullptr;  ///< S (A until the pair is classified)
   const Simplex<dim>* large = nullptr;  ///< L
   NodalMatrix<dim> beta;                ///< β_jk = λ^L_j(s_k) (set unless empty)
-  NodalMatrix<dim> gamma;               ///< γ_ik = λ^S_i(l_k) (set for large_inside and clipped)
 };
 
 // table[j][k] = λ^T_j(p_k) for the vertices p_k of P, as T.barycentric(j, p_k) (same
@@ -130,27 +135,9 @@ Overlap<dim> find_overlap(const Simplex<dim>& a, const Simplex<dim>& b, Polytope
     if (lowest[j] < -tol) cutting |= 1u << j;
   }
   if (overlap.a_is_small) overlap.b_crossed = cutting;  // B = L
-  if (cutting == 0) {
-    overlap.separated = false;
-    overlap.kind = Kind::small_inside;
-    return overlap;
-  }
-
-  // 4. faces of S against the vertices of L
-  bool large_inside = true;
-  unsigned crossed = 0;  // faces of S crossed by L
-  barycentric_table(small, large, overlap.gamma, lowest, highest);
-  for (int i = 0; i <= dim; ++i) {
-    if (!(highest[i] > tol)) return overlap;
-    if (lowest[i] < -tol) {
-      large_inside = false;
-      crossed |= 1u << i;
-    }
-  }
-  if (!overlap.a_is_small) overlap.b_crossed = crossed;  // B = S
   overlap.separated = false;
-  if (large_inside) {
-    overlap.kind = Kind::large_inside;
+  if (cutting == 0) {
+    overlap.kind = Kind::small_inside;
     return overlap;
   }
 
@@ -177,9 +164,33 @@ Overlap<dim> find_overlap(const Simplex<dim>& a, const Simplex<dim>& b, Polytope
     HalfSpace<dim> plane;
     plane.offset = overlap.beta[j][0];
     for (int k = 0; k < dim; ++k) plane.normal[k] = overlap.beta[j][k + 1] - overlap.beta[j][0];
-    if (!polytope.clip(plane, tol)) return overlap;
+    bool left;
+    if constexpr (dim == 2) {
+      left = polytope.clip(plane, tol);
+    } else {
+      left = polytope.clip(plane, tol, j);
+    }
+    if (!left) {
+      // Nothing left. The vertices of L against the face planes of S tell whether one of
+      // those separates (as in step 3: the front then does not go on from this pair) and,
+      // when B = S, which faces of B they cross.
+      NodalMatrix<dim> gamma;  // γ_ik = λ^S_i(l_k)
+      barycentric_table(small, large, gamma, lowest, highest);
+      unsigned crossed = 0;
+      for (int i = 0; i <= dim; ++i) {
+        if (!(highest[i] > tol)) overlap.separated = true;
+        if (lowest[i] < -tol) crossed |= 1u << i;
+      }
+      if (!overlap.a_is_small) overlap.b_crossed = crossed;
+      return overlap;
+    }
   }
   overlap.kind = Kind::clipped;
+  // The faces of B that A∩B touches (in 2D not known: all).
+  if constexpr (dim == 3) {
+    const unsigned touched = polytope.touched_planes();  // bits 0–3: faces of S, 4–7: of L
+    overlap.b_touched = overlap.a_is_small ? touched >> 4 : touched & 0xFu;
+  }
   return overlap;
 }
 
@@ -248,9 +259,6 @@ bool moments_of_intersection(const Simplex<dim>& a, const Simplex<dim>& b,
     case Kind::small_inside:
       m = simplex_moments(*overlap.small);
       break;
-    case Kind::large_inside:
-      m = simplex_moments(*overlap.large);
-      break;
     case Kind::clipped:
       m = physical_moments(*overlap.small, workspace.polytope.moments());
       break;
@@ -273,7 +281,6 @@ Contact integrals_of_intersection(const Simplex<dim>& a, const Simplex<dim>& b,
   using Kind = typename Overlap<dim>::Kind;
   const Overlap<dim> overlap = find_overlap(a, b, workspace.polytope);
   const Simplex<dim>& small = *overlap.small;
-  const Simplex<dim>& large = *overlap.large;
   constexpr double pair_factor = 1.0 / ((dim + 1) * (dim + 2));
   Moments<dim> moments;
   NodalMatrix<dim> mass;  // ∫ λ^S_i λ^L_j
@@ -293,18 +300,6 @@ Contact integrals_of_intersection(const Simplex<dim>& a, const Simplex<dim>& b,
           mass[i][j] = small.measure * pair_factor * (overlap.beta[j][i] + sum);
       }
       for (int i = 0; i <= dim; ++i) integral_s[i] = small.measure / (dim + 1);
-      break;
-    }
-    case Kind::large_inside: {  // Ω = L: ∫_L λ^S_i λ^L_j = |L| (γ_ij + Σ_k γ_ik) / ((d+1)(d+2))
-      moments = workspace.second_moment ? simplex_moments(large) : first_moments(large);
-      for (int i = 0; i <= dim; ++i) {
-        double sum = 0.0;
-        for (int k = 0; k <= dim; ++k) sum += overlap.gamma[i][k];
-        integral_s[i] = large.measure * sum / (dim + 1);
-        for (int j = 0; j <= dim; ++j)
-          mass[i][j] = large.measure * pair_factor * (overlap.gamma[i][j] + sum);
-      }
-      for (int j = 0; j <= dim; ++j) integral_l[j] = large.measure / (dim + 1);
       break;
     }
     case Kind::clipped: {
@@ -357,7 +352,7 @@ Contact integrals_of_intersection(const Simplex<dim>& a, const Simplex<dim>& b,
       for (int j = 0; j <= dim; ++j) mass[i][j] *= scale;
     }
   }
-  out.crossed_faces_b = overlap.b_crossed;
+  out.crossed_faces_b = overlap.b_crossed & overlap.b_touched;
   out.moments = moments;
   if (overlap.a_is_small) {
     out.integral_a = integral_s;
@@ -384,9 +379,6 @@ std::span<const QuadraturePoint<dim>> quadrature_of_intersection(
       return {};
     case Kind::small_inside:
       n = simplex_quadrature(*overlap.small, points);
-      break;
-    case Kind::large_inside:
-      n = simplex_quadrature(*overlap.large, points);
       break;
     case Kind::clipped: {
       n = workspace.polytope.quadrature(points);

@@ -17,9 +17,10 @@
 /// Contract for every pair: the result is finite, 0 ≤ |A∩B| ≤ min(|A|, |B|), and a pair
 /// whose intersection has zero measure (disjoint, touching at a vertex, edge or face,
 /// degenerate element) returns false / no points. Pairs are rejected cheaply first: by
-/// bounding boxes, then by a separating face plane (all vertices of one simplex on or
-/// outside one face plane of the other), and a simplex inside the other is recognised
-/// without clipping. See intersection.cpp for the algorithm.
+/// bounding boxes, then by a separating face plane of the larger simplex (all vertices of the
+/// smaller one on or outside it; one of the smaller simplex leaves nothing of the clipping),
+/// and the smaller simplex inside the larger is recognised without clipping. See
+/// intersection.cpp for the algorithm.
 
 #include <span>
 
@@ -70,9 +71,11 @@ struct LocalIntegrals {
   NodalVector<dim> integral_a{};  ///< ∫ λ^A_i [m^dim]
   NodalVector<dim> integral_b{};  ///< ∫ λ^B_j [m^dim]
   NodalMatrix<dim> mass{};        ///< M_ij = ∫ λ^A_i λ^B_j [m^dim], row i: A, column j: B
-  /// Bit j set: some vertex of A lies strictly beyond face plane j of B (λ^B_j < −tol), or it
-  /// is not known (all bits); set by local_integrals_contact() for every pair not separated,
-  /// from the kernel's own β / γ (the advancing front crosses only these faces of B).
+  /// The faces of B an advancing front has to cross (search.hpp), set by
+  /// local_integrals_contact() for every pair not separated. Bit j clear: A∩B does not touch
+  /// face j of B (3D overlapping pair that needed clipping: no vertex of the clipped polytope on
+  /// that plane), or no vertex of A lies strictly beyond face plane j (λ^B_j ≥ −tol, from the
+  /// kernel's own β / γ). All bits set: not known.
   unsigned crossed_faces_b = ~0u;
   double measure() const { return moments.measure; }
 };

@@ -21,10 +21,10 @@
 ///    the box overlaps that do not intersect. The pairs are stored grouped by slave cell.
 ///  Stage 2 by advancing front (SearchOptions::front, what the operators use): no pair list
 ///    is made up front; sweep() walks the owned slave cells and, for each, the received
-///    master cells through their face neighbours, starting from the cells an earlier face
-///    neighbour of the slave cell overlaps, with the caller's test (the intersection kernel
-///    itself) deciding which cells the front crosses. Cells it cannot vouch for fall back to
-///    the grid (see sweep()).
+///    master cells through their face neighbours, starting from one of the cells an earlier
+///    face neighbour of the slave cell overlaps, with the caller's test (the intersection
+///    kernel itself) deciding which faces of which cells the front crosses. Cells it cannot
+///    vouch for fall back to the grid (see sweep()).
 ///
 /// Moving master (the solid moves through a fixed fluid mesh): the search is built with the
 /// master boxes inflated by `SearchOptions::margin`. While no master vertex has moved more
@@ -319,22 +319,26 @@ class PairSearch {
   /// with all bits set; the test may clear bit i when no vertex of s lies strictly beyond face
   /// plane i of master cell m (λ_i ≥ −kPlaneTolerance: LocalIntegrals::crossed_faces_b).
   ///
-  /// Per slave cell S: the front starts from the master cells that the first earlier face
-  /// neighbour of S with any overlaps found, and crosses every face of every master cell the
-  /// test does not call separated. Why that finds every overlapping cell: two points of
-  /// int(S ∩ M) in master cells T₁, T₂ are joined by a segment in int S (S is convex) that,
-  /// moved generically, crosses master cells through faces only, each of them overlapping S
-  /// (the test never calls such a cell separated); so from one overlapping cell the front
-  /// reaches all of them unless the segment leaves the received master cells, through a face
-  /// without a neighbour of a cell the front reached, which S must then cross. So S falls back
-  /// to the grid (box candidates the front has not tested) when the front found no
-  /// overlapping cell (no seed, disconnected pieces, S outside M) or when some crossed cell
-  /// has an open face whose plane S crosses (a vertex of S at λ < −kPlaneTolerance):
-  /// the master's boundary, a face to a cell this rank did not receive, a non-conforming face.
-  /// The same argument lets the front skip the faces of a cell whose plane S does not cross:
-  /// a segment in int S never goes through them. A degenerate master cell has no interior for
-  /// the segment to cross, but its faces may be the only link between two overlapping cells, so
-  /// the front crosses all its faces.
+  /// Per slave cell S: the seeds are the master cells that the first earlier face neighbour
+  /// of S with any overlaps found; the front starts from one of them (the one whose box centre
+  /// is nearest to the centroid of S, the likeliest to overlap S) and crosses the faces the
+  /// test leaves in `crossed` of every master cell it does not call separated; only when it
+  /// ends without an overlapping cell does it go on from the next seed not reached yet. Why
+  /// that finds every overlapping cell: two points of int(S ∩ M) in master cells T₁, T₂ are
+  /// joined by a segment in int S (S is convex) that, moved generically, crosses master cells
+  /// through faces only, each of them overlapping S (the test never calls such a cell
+  /// separated) and each face meeting int S; so from one overlapping cell the front reaches
+  /// all of them unless the segment leaves the received master cells, through a face without
+  /// a neighbour of a cell the front reached, which S must then cross. So S falls back to the
+  /// grid (box candidates the front has not tested) when the front found no overlapping cell
+  /// (no seed, disconnected pieces, S outside M) or when some crossed cell has an open face
+  /// in `crossed` whose plane S crosses (a vertex of S at λ < −kPlaneTolerance): the master's
+  /// boundary, a face to a cell this rank did not receive, a non-conforming face. The same
+  /// argument lets the front skip the faces the segment cannot go through: those whose plane S
+  /// does not cross, and those of an overlapping cell that S ∩ M_cell does not touch (the
+  /// kernel's crossed_faces_b). A degenerate master cell has no interior for the segment to
+  /// cross, but its faces may be the only link between two overlapping cells, so the front
+  /// crosses all its faces.
   template <class Test, class Finish>
   void sweep(Test&& test, Finish&& finish);
   /// Frees the pair list and the front's scratch (pairs_of() is empty afterwards); for a
@@ -375,6 +379,8 @@ class PairSearch {
   std::vector<int> master_neighbors_;  ///< face_neighbors of the received master cells
   std::vector<int> visited_;           ///< per received master cell: last slave cell testing it
   std::vector<int> queue_;             ///< the front of one slave cell
+  /// The seed (a received master cell) whose box centre is nearest to the centroid of s.
+  int nearest_seed(const Simplex<dim>& s, std::span<const int> seeds) const;
   void store_pairs(int c, std::size_t& chunk);
   void finish_statistics();
 };
@@ -438,6 +444,28 @@ void BoxGrid<dim>::query(const Box<dim>& query, Visit&& visit) const {
 }
 
 template <int dim>
+int PairSearch<dim>::nearest_seed(const Simplex<dim>& s, std::span<const int> seeds) const {
+  Point<dim> centroid{};
+  for (const Point<dim>& v : s.vertices)
+    for (int d = 0; d < dim; ++d) centroid[d] += v[d] / (dim + 1);
+  int nearest = seeds[0];
+  double nearest_distance = std::numeric_limits<double>::infinity();
+  for (const int m : seeds) {
+    const Simplex<dim>& t = master_simplices_[static_cast<std::size_t>(m)];
+    double distance = 0.0;  // squared, to twice the box centre
+    for (int d = 0; d < dim; ++d) {
+      const double e = t.box_lower[d] + t.box_upper[d] - 2.0 * centroid[d];
+      distance += e * e;
+    }
+    if (distance < nearest_distance) {
+      nearest_distance = distance;
+      nearest = m;
+    }
+  }
+  return nearest;
+}
+
+template <int dim>
 template <class Test, class Finish>
 void PairSearch<dim>::sweep(Test&& test, Finish&& finish) {
   COAPT_ASSERT(options_.front, "PairSearch::sweep needs SearchOptions::front");
@@ -455,17 +483,32 @@ void PairSearch<dim>::sweep(Test&& test, Finish&& finish) {
     scratch_.clear();
     if (!s.degenerate()) {
       queue_.clear();
+      std::span<const int> seeds;
       for (int i = 0; i < k; ++i) {
         const int n = slave_neighbors_[static_cast<std::size_t>(c) * k + i];
         if (n < 0 || n > c || cell_pairs_[static_cast<std::size_t>(n)].count == 0) continue;
-        for (const int m : pairs_of(n)) {
-          visited_[m] = c;
-          queue_.push_back(m);
-        }
+        seeds = pairs_of(n);
         break;
       }
+      // One seed at a time (see above): the nearest first, then the others in order.
+      int nearest = seeds.empty() ? -1 : nearest_seed(s, seeds);
+      std::size_t next_seed = 0;
       bool open = false;  // a crossed cell has an open face whose plane S crosses
-      for (std::size_t q = 0; q < queue_.size(); ++q) {
+      for (std::size_t q = 0;; ++q) {
+        if (q == queue_.size()) {        // the front from the seeds so far has ended
+          if (!scratch_.empty()) break;  // ... and found all the cells S overlaps
+          int seed = -1;
+          if (nearest >= 0) {
+            seed = nearest;
+            nearest = -1;
+          } else {
+            while (next_seed < seeds.size() && visited_[seeds[next_seed]] == c) ++next_seed;
+            if (next_seed < seeds.size()) seed = seeds[next_seed++];
+          }
+          if (seed < 0) break;
+          visited_[seed] = c;
+          queue_.push_back(seed);
+        }
         const int m = queue_[q];
         ++tests;
         unsigned crossed = ~0u;

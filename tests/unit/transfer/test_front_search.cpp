@@ -2,19 +2,25 @@
 // search: on jittered, rotated, partly outside and disconnected masters, in 2D and 3D, the
 // front must find exactly the overlapping pairs the grid's pair list holds (the grid's pairs
 // filtered by the kernel), test no pair twice, and leave most slave cells to the front when
-// the meshes overlap in one piece. Also face_neighbors against a direct count.
+// the meshes overlap in one piece; the faces the kernel tells the front not to cross must be
+// faces whose plane no vertex of the slave cell crosses or, for an overlapping pair, that the
+// intersection (clipped again here, in physical coordinates) does not reach. Also
+// face_neighbors against a direct count.
 
 #include <gtest/gtest.h>
 #include <petscmat.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <set>
 #include <utility>
 
 #include "../../support/mesh_transforms.hpp"
 #include "coapt/mesh/generators.hpp"
+#include "coapt/transfer/clipping.hpp"
 #include "coapt/transfer/intersection.hpp"
 #include "coapt/transfer/operators.hpp"
 #include "coapt/transfer/search.hpp"
@@ -76,6 +82,21 @@ Mesh without_slab(const Mesh& m, int axis, double lower, double upper) {
   return out;
 }
 
+/// The lowest λ^B_i over the vertices of A ∩ B, clipped here independently of the kernel (A
+/// in physical coordinates by the face half-spaces of B); +∞ when nothing is left.
+double lowest_on_intersection(const Simplex<3>& a, const Simplex<3>& b, int i) {
+  ConvexPolyhedron polytope;
+  polytope.assign_tetrahedron(a.vertices);
+  for (int j = 0; j <= 3; ++j)
+    if (!polytope.clip(HalfSpace<3>::through(b.gradients[j], b.vertices[Simplex<3>::anchor(j)]),
+                       kPlaneTolerance))
+      return std::numeric_limits<double>::infinity();
+  double lowest = std::numeric_limits<double>::infinity();
+  for (int v = 0; v < polytope.size(); ++v)
+    lowest = std::min(lowest, b.barycentric(i, polytope.vertex(v)));
+  return lowest;
+}
+
 struct FrontResult {
   std::int64_t fallbacks = 0;
   std::int64_t tests = 0;
@@ -108,10 +129,19 @@ FrontResult expect_front_matches_grid(const Mesh& slave, const Mesh& master) {
             local_integrals_contact(s, front.master_simplices()[m], workspace, local);
         crossed = local.crossed_faces_b;
         if (contact != Contact::separated) {  // the bits the kernel cleared are right
+          const Simplex<dim>& t = front.master_simplices()[m];
           for (int i = 0; i <= dim; ++i) {
             if ((crossed >> i) & 1u) continue;
+            bool plane_crossed = false;  // by a vertex of s
             for (const auto& x : s.vertices)
-              EXPECT_GE(front.master_simplices()[m].barycentric(i, x), -kPlaneTolerance);
+              plane_crossed = plane_crossed || t.barycentric(i, x) < -kPlaneTolerance;
+            if (!plane_crossed) continue;
+            // then only because s ∩ t stays off face i (3D clipped pairs)
+            EXPECT_EQ(dim, 3);
+            EXPECT_EQ(contact, Contact::overlapping);
+            if constexpr (dim == 3) {
+              EXPECT_GT(lowest_on_intersection(s, t, i), 0.0);
+            }
           }
         }
         return contact;
