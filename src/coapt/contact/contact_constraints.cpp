@@ -241,50 +241,112 @@ MortarOptions ContactConstraints::mortar_options(std::size_t p) const {
   return options;
 }
 
-int ContactConstraints::project_predictor(Vec u, Vec increment) {
-  // With a lumped mass and node-wise normal coordinates the projection of uₙ + δ onto the
-  // admissible set in the mass norm is a node-wise clip of the normal components (refs §6.1:
-  // pred = O min(Oᵀ δ, g)). For slave node j the predicted gap is
-  //   g_j' = g_j + n_j · (m_j − δ_j),  m_j = Σ_l M_jl δ_l / D_jj,
-  // the mortar projection of the master's increment; where g_j' < 0 the slave's increment
-  // loses its penetrating normal part: δ_j ← δ_j + g_j' n_j, so g_j' becomes 0. The master's
-  // increment is kept (exact for a fixed master; with two deformable bodies the projection
-  // is a small quadratic program, method/notes.md, which this node-wise clip approximates).
-  std::vector<double> slave_increment, master_increment;
-  int clipped = 0;
+int ContactConstraints::project_predictor(Vec u, Vec increment, Vec lumped_mass) {
+  // The predictor uₙ + δ projected onto the admissible set in the lumped-mass norm
+  // (Deuflhard, Krause, Ertel 2008; method/notes.md): min ½ Σ_i m_i (δ_i − δ̂_i)² subject to
+  // the linearised weighted gaps
+  //   G_j(δ) = g̃_j + n_j · (Σ_l M_jl δ_l − Σ_k D̂_jk δ_k) ≥ 0
+  // of the constrained slave nodes (mortar operators at u = uₙ). With a held master (the
+  // master's mass infinite) every constraint moves its own slave node only and the
+  // projection is the node-wise clip of the normal component. With two deformable bodies the
+  // gaps couple slave and master nodes: the quadratic program is solved by projected
+  // Gauss–Seidel on its multipliers μ_j ≥ 0, δ = δ̂ + M⁻¹ Σ_j μ_j a_j with a_j = ∂G_j/∂δ
+  // (−D̂_jk n_j on slave nodes, M_jl n_j on master nodes). Its correction conserves linear
+  // momentum (Σ_i m_i Δδ_i = Σ_j μ_j (Σ_l M_jl − Σ_k D̂_jk) n_j = 0 on covered nodes), where a
+  // clip of the slave alone would not. Prescribed components do not move (infinite mass).
+  constexpr int kMaxSweeps = 200;
+  int projected_nodes = 0;
+  std::vector<double> slave_increment, master_increment, slave_mass, master_mass;
   for (std::size_t p = 0; p < pairs_.size(); ++p) {
     const auto& pair = pairs_[p];
     std::vector<double> slave_x, master_x;
     current_positions(p, u, slave_x, master_x);
     slave_gathers_[p]->gather(increment, slave_increment);
     master_gathers_[p]->gather(increment, master_increment);
+    slave_gathers_[p]->gather(lumped_mass, slave_mass);
+    master_gathers_[p]->gather(lumped_mass, master_mass);
     const auto m = assemble_mortar(pair.slave, slave_x, pair.master, master_x, mortar_options(p));
-    std::vector<double> projected(static_cast<std::size_t>(pair.slave.n_nodes()) * dim_, 0.0);
+    // 1/m per dof (0 where prescribed or massless).
+    const auto inverse = [](const std::vector<double>& mass, const std::vector<char>& fixed) {
+      std::vector<double> result(mass.size(), 0.0);
+      for (std::size_t k = 0; k < mass.size(); ++k)
+        if (!fixed[k] && mass[k] > 0.0) result[k] = 1.0 / mass[k];
+      return result;
+    };
+    const auto slave_inverse = inverse(slave_mass, pair.dirichlet);
+    const auto master_inverse = inverse(master_mass, pair.master_dirichlet);
+    // The constraints' entries by row (slave_coupling and master_coupling are sorted by row).
+    struct Term {
+      bool master;
+      int node;
+      double coefficient;  // of n_j in a_j
+    };
+    std::vector<std::vector<Term>> rows(static_cast<std::size_t>(pair.slave.n_nodes()));
+    for (const auto& e : m.slave_coupling)
+      if (m.constrained(e.row)) rows[e.row].push_back({false, e.column, -e.value});
     for (const auto& e : m.master_coupling)
-      for (int i = 0; i < dim_; ++i)
-        projected[static_cast<std::size_t>(e.row) * dim_ + i] +=
-            e.value * master_increment[static_cast<std::size_t>(e.column) * dim_ + i];
-    for (int j = 0; j < pair.slave.n_nodes(); ++j) {
-      if (!m.constrained(j)) continue;
-      double closing = 0.0;
-      for (int i = 0; i < dim_; ++i) {
-        const std::size_t k = static_cast<std::size_t>(j) * dim_ + i;
-        closing += m.normals[k] * (slave_increment[k] - projected[k] / m.dual_mass[j]);
-      }
-      const double gap = m.gap(j) - closing;
-      if (gap >= 0.0) continue;
-      ++clipped;
-      for (int i = 0; i < dim_; ++i) {
-        const std::size_t k = static_cast<std::size_t>(j) * dim_ + i;
-        const PetscInt dof = pair.slave.global_vertex[j] * dim_ + i;
-        if (dof < first_dof_ || dof >= end_dof_ || pair.dirichlet[k]) continue;
-        COAPT_PETSC_CHECK(VecSetValue(increment, dof, gap * m.normals[k], ADD_VALUES));
-      }
+      if (m.constrained(e.row)) rows[e.row].push_back({true, e.column, e.value});
+    std::vector<double> weight(rows.size(), 0.0), multiplier(rows.size(), 0.0);
+    for (std::size_t j = 0; j < rows.size(); ++j) {
+      const double* n = m.normals.data() + j * dim_;
+      for (const auto& t : rows[j])
+        for (int i = 0; i < dim_; ++i) {
+          const std::size_t k = static_cast<std::size_t>(t.node) * dim_ + i;
+          const double w = t.master ? master_inverse[k] : slave_inverse[k];
+          weight[j] += t.coefficient * t.coefficient * n[i] * n[i] * w;
+        }
     }
+    const auto gap = [&](std::size_t j) {
+      const double* n = m.normals.data() + j * dim_;
+      double g = m.weighted_gap[j];
+      for (const auto& t : rows[j])
+        for (int i = 0; i < dim_; ++i) {
+          const std::size_t k = static_cast<std::size_t>(t.node) * dim_ + i;
+          g += t.coefficient * n[i] * (t.master ? master_increment[k] : slave_increment[k]);
+        }
+      return g;
+    };
+    double scale = 0.0;  // the largest |G_j(δ̂)|, for the stopping test
+    for (std::size_t j = 0; j < rows.size(); ++j)
+      if (!rows[j].empty())
+        scale = std::max({scale, std::abs(m.weighted_gap[j]), std::abs(gap(j))});
+    for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
+      double largest = 0.0;
+      for (std::size_t j = 0; j < rows.size(); ++j) {
+        if (rows[j].empty() || !(weight[j] > 0.0)) continue;
+        const double step = std::max(-multiplier[j], -gap(j) / weight[j]);
+        if (step == 0.0) continue;
+        multiplier[j] += step;
+        const double* n = m.normals.data() + j * dim_;
+        for (const auto& t : rows[j])
+          for (int i = 0; i < dim_; ++i) {
+            const std::size_t k = static_cast<std::size_t>(t.node) * dim_ + i;
+            if (t.master)
+              master_increment[k] += step * t.coefficient * n[i] * master_inverse[k];
+            else
+              slave_increment[k] += step * t.coefficient * n[i] * slave_inverse[k];
+          }
+        largest = std::max(largest, std::abs(step) * weight[j]);
+      }
+      if (largest <= 1e-12 * scale) break;
+    }
+    for (std::size_t j = 0; j < rows.size(); ++j) projected_nodes += multiplier[j] > 0.0 ? 1 : 0;
+    // Each rank writes its owned entries of the (identical) result.
+    const auto write = [&](const Surface& surface, const std::vector<double>& values) {
+      for (int node = 0; node < surface.n_nodes(); ++node)
+        for (int i = 0; i < dim_; ++i) {
+          const PetscInt dof = surface.global_vertex[node] * dim_ + i;
+          if (dof < first_dof_ || dof >= end_dof_) continue;
+          COAPT_PETSC_CHECK(VecSetValue(
+              increment, dof, values[static_cast<std::size_t>(node) * dim_ + i], INSERT_VALUES));
+        }
+    };
+    write(pair.slave, slave_increment);
+    write(pair.master, master_increment);
+    COAPT_PETSC_CHECK(VecAssemblyBegin(increment));
+    COAPT_PETSC_CHECK(VecAssemblyEnd(increment));
   }
-  COAPT_PETSC_CHECK(VecAssemblyBegin(increment));
-  COAPT_PETSC_CHECK(VecAssemblyEnd(increment));
-  return clipped;
+  return projected_nodes;
 }
 
 void ContactConstraints::build_row_operator() {

@@ -106,11 +106,12 @@ class ContactConstraints {
   /// rhs ← P rhs + c n g̃ on A, for K Δu = rhs = −R after the solid's Dirichlet treatment.
   /// Collective.
   Mat transform(Mat K, Vec rhs);
-  /// Contact-stabilized Newmark predictor: clips the normal part of the increment δ (a
-  /// displacement-layout vector, owned entries) at every slave node that uₙ + δ would push
-  /// through its master (mortar operators at the displacement u = uₙ); returns the number of
-  /// slave nodes clipped. Collective.
-  int project_predictor(Vec u, Vec increment);
+  /// Contact-stabilized Newmark predictor: projects the increment δ (a displacement-layout
+  /// vector, owned entries) so that uₙ + δ does not penetrate, in the norm of the lumped mass
+  /// `lumped_mass` (same layout; mortar operators at the displacement u = uₙ): a node-wise clip
+  /// against a held master, a small quadratic program between two deformable bodies (see the
+  /// definition). Returns the number of slave nodes whose constraint is active. Collective.
+  int project_predictor(Vec u, Vec increment, Vec lumped_mass);
   /// Forgets the previous active set's change count (a new step). Not collective.
   void begin_step() { settled_updates_ = 0; }
 

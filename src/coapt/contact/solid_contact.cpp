@@ -282,9 +282,9 @@ bool ContactHook::accept(Vec u) {
   return false;
 }
 
-void ContactHook::project_predictor(Vec u, Vec increment) {
+void ContactHook::project_predictor(Vec u, Vec increment, Vec lumped_mass) {
   const double start = MPI_Wtime();
-  const int clipped = constraints_.project_predictor(u, increment);
+  const int clipped = constraints_.project_predictor(u, increment, lumped_mass);
   seconds_ += MPI_Wtime() - start;
   if (clipped > 0) log::debug("contact: the predictor was clipped at {} slave node(s)", clipped);
 }

@@ -103,7 +103,7 @@ class ContactHook final : public solid::NewtonHook {
   void add_residual(Vec u, Vec residual) override;
   Mat linear_system(Vec u, Mat K, Vec rhs) override;
   bool accept(Vec u) override;
-  void project_predictor(Vec u, Vec increment) override;
+  void project_predictor(Vec u, Vec increment, Vec lumped_mass) override;
 
   const ContactConstraints& constraints() const { return constraints_; }
   /// Newton iterations of the current step after which the active set changed (the step

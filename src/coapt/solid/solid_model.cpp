@@ -418,7 +418,13 @@ class SolidModelImpl {
       COAPT_PETSC_CHECK(VecCopy(v_committed_, predictor_));
       COAPT_PETSC_CHECK(VecScale(predictor_, time_step));
       zero_dirichlet(predictor_);
-      if (hook_) hook_->project_predictor(u_committed_, predictor_);
+      if (hook_) {
+        if (!lumped_mass_) {  // the mass is lumped by rows here: its diagonal is the whole of it
+          COAPT_PETSC_CHECK(VecDuplicate(predictor_, lumped_mass_.out()));
+          COAPT_PETSC_CHECK(MatGetDiagonal(mass_->mat(), lumped_mass_));
+        }
+        hook_->project_predictor(u_committed_, predictor_, lumped_mass_);
+      }
       COAPT_PETSC_CHECK(VecWAXPY(u_, 1.0, predictor_, u_committed_));
     } else {  // predictor u = uₙ + Δt vₙ + Δt²/2 aₙ (Dirichlet dofs: v = a = 0, u stays)
       WriteArray u(u_);
@@ -457,6 +463,8 @@ class SolidModelImpl {
     COAPT_PETSC_CHECK(VecCopy(u_, u_committed_));
     COAPT_PETSC_CHECK(VecCopy(v_, v_committed_));
     COAPT_PETSC_CHECK(VecCopy(a_, a_committed_));
+    // VecCopy copies the owned entries only: the ghosts of uₙ are read by the assembly below.
+    fem::update_ghosts(u_committed_);
     if (parameters_.time.contact_stabilized) commit_static_residual();
   }
 
@@ -1562,6 +1570,7 @@ class SolidModelImpl {
   std::array<double, 2> static_factors_{0, 0};  ///< sₙ₋₁, sₙ of the converged static steps
   fem::P1Matrix matrix_;
   std::optional<fem::P1Matrix> mass_;  ///< inertia-density mass (dynamics only)
+  OwnedVec lumped_mass_;               ///< its diagonal (contact-stabilized predictor)
   fem::LinearSolver solver_;
   Vec extra_force_ = nullptr;   ///< not owned
   NewtonHook* hook_ = nullptr;  ///< not owned

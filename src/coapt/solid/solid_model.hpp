@@ -76,10 +76,12 @@ class NewtonHook {
   }
   /// Contact-stabilized Newmark, once per step before begin_step: projects the predictor
   /// increment δ (owned entries; Δt vₙ on entry) from the committed displacement `u` onto
-  /// the admissible set, in place.
-  virtual void project_predictor(Vec u, Vec increment) {
+  /// the admissible set, in place, in the norm of `lumped_mass` (the lumped inertia mass per
+  /// dof, same layout).
+  virtual void project_predictor(Vec u, Vec increment, Vec lumped_mass) {
     (void)u;
     (void)increment;
+    (void)lumped_mass;
   }
 };
 
