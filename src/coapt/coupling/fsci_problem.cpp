@@ -19,6 +19,7 @@
 #include "coapt/fem/assembly.hpp"
 #include "coapt/fluid/fluid_model.hpp"
 #include "coapt/mesh/mesh_input.hpp"
+#include "coapt/solid/dynamics.hpp"
 #include "coapt/solid/solid_model.hpp"
 
 namespace coapt::coupling {
@@ -62,6 +63,14 @@ struct Benchmark {
   std::string probe_solid, probe;
   double reference_drag_force = 0, reference_lift_force = 0;
   double reference_displacement_x = 0, reference_displacement_y = 0;
+  // forces, transient: last-period statistics of the steps from statistics_from on; reference
+  // amplitudes and frequencies (the reference_* above are then the means)
+  bool statistics = false;
+  double statistics_from = 0;  ///< [s]
+  double reference_drag_amplitude = 0, reference_lift_amplitude = 0;
+  double reference_displacement_x_amplitude = 0, reference_displacement_y_amplitude = 0;
+  double reference_drag_frequency = 0, reference_lift_frequency = 0;
+  double reference_displacement_x_frequency = 0, reference_displacement_y_frequency = 0;
   double mean_velocity = 1, diameter = 1;
   std::vector<double> pressure_points;  ///< x_A, y_A, x_B, y_B: Δp = p(A) − p(B)
   // valve: the solid whose contact closes it and the boundary group whose flow is the leak
@@ -218,13 +227,43 @@ Parameters read(const config::Section& root) {
     b.probe_solid = benchmark.get<std::string>("probe_solid", "", {"", "solid of the probe"});
     b.probe = benchmark.get<std::string>(
         "probe", "", {"", "a probe of that solid: displacement_x, displacement_y (and _z in 3D)"});
+    b.statistics = benchmark.has("statistics_from");
+    b.statistics_from = benchmark.get<double>(
+        "statistics_from", 0.0,
+        {"s",
+         "transient runs: mean, amplitude and frequency of drag, lift and the probe's "
+         "displacement over their last full period among the steps from this time on (not "
+         "given: not computed)",
+         Bounds::non_negative()});
+    if (b.statistics && p.time.steady)
+      benchmark.fail("statistics_from", "needs a transient run (time.steady: false)");
     auto reference = benchmark.section("reference", "published values (relative errors)");
-    b.reference_drag_force = reference.get<double>("drag", 0.0, {"N/m", "drag (0: none)"});
-    b.reference_lift_force = reference.get<double>("lift", 0.0, {"N/m", "lift (0: none)"});
-    b.reference_displacement_x =
-        reference.get<double>("displacement_x", 0.0, {"m", "probe u_x (0: none)"});
-    b.reference_displacement_y =
-        reference.get<double>("displacement_y", 0.0, {"m", "probe u_y (0: none)"});
+    b.reference_drag_force = reference.get<double>(
+        "drag", 0.0, {"N/m", "drag (with statistics_from: its mean; 0: none)"});
+    b.reference_lift_force = reference.get<double>(
+        "lift", 0.0, {"N/m", "lift (with statistics_from: its mean; 0: none)"});
+    b.reference_displacement_x = reference.get<double>(
+        "displacement_x", 0.0, {"m", "probe u_x (with statistics_from: its mean; 0: none)"});
+    b.reference_displacement_y = reference.get<double>(
+        "displacement_y", 0.0, {"m", "probe u_y (with statistics_from: its mean; 0: none)"});
+    const auto amplitude = [&](const char* key, const char* unit) {
+      return reference.get<double>(
+          key, 0.0,
+          {unit, "with statistics_from: the amplitude (0: none)", Bounds::non_negative()});
+    };
+    const auto frequency = [&](const char* key) {
+      return reference.get<double>(
+          key, 0.0,
+          {"Hz", "with statistics_from: the frequency (0: none)", Bounds::non_negative()});
+    };
+    b.reference_drag_amplitude = amplitude("drag_amplitude", "N/m");
+    b.reference_lift_amplitude = amplitude("lift_amplitude", "N/m");
+    b.reference_displacement_x_amplitude = amplitude("displacement_x_amplitude", "m");
+    b.reference_displacement_y_amplitude = amplitude("displacement_y_amplitude", "m");
+    b.reference_drag_frequency = frequency("drag_frequency");
+    b.reference_lift_frequency = frequency("lift_frequency");
+    b.reference_displacement_x_frequency = frequency("displacement_x_frequency");
+    b.reference_displacement_y_frequency = frequency("displacement_y_frequency");
     for (const auto& name : b.solids)
       if (std::none_of(p.solids.begin(), p.solids.end(),
                        [&](const SolidEntry& s) { return s.name == name; }))
@@ -366,6 +405,14 @@ class FsciProblem final : public run::Problem {
       if (probe_index_ < 0)
         throw InputError(
             fmt::format("benchmark.probe: solid '{}' has no probe '{}'", b.probe_solid, b.probe));
+    }
+    if (b.type == "forces") {
+      forces_.names = {"drag", "lift"};
+      static constexpr const char* components[] = {"displacement_x", "displacement_y",
+                                                   "displacement_z"};
+      if (probe_index_ >= 0)
+        for (int i = 0; i < dim; ++i) forces_.names.emplace_back(components[i]);
+      forces_.values.resize(forces_.names.size());
     }
   }
 
@@ -582,6 +629,10 @@ class FsciProblem final : public run::Problem {
     valve["closed"] =
         io::Json::array_of(std::vector<int>(valve_.closed.begin(), valve_.closed.end()));
     valve["max_penetration"] = valve_.max_penetration;
+    auto& forces = state["forces_history"];
+    forces["times"] = io::Json::array_of(forces_.times);
+    auto& columns = forces["values"] = io::Json::array();
+    for (const auto& values : forces_.values) columns.push_back(io::Json::array_of(values));
     writer.commit();
   }
 
@@ -638,6 +689,16 @@ class FsciProblem final : public run::Problem {
     for (const auto& value : valve.at("closed").as_array())
       valve_.closed.push_back(value.as_int() != 0 ? 1 : 0);
     valve_.max_penetration = valve.at("max_penetration").as_double();
+    if (state.contains("forces_history")) {  // absent from checkpoints written before it
+      const auto& forces = state.at("forces_history");
+      const auto& columns = forces.at("values").as_array();
+      if (columns.size() != forces_.values.size())
+        throw InputError(fmt::format(
+            "--restart {}: the checkpoint's force statistics have {} quantities, this case {}",
+            reader.directory().string(), columns.size(), forces_.values.size()));
+      forces_.times = doubles(forces.at("times"));
+      for (std::size_t q = 0; q < columns.size(); ++q) forces_.values[q] = doubles(columns[q]);
+    }
     return static_cast<int>(state.at("step").as_int());
   }
 
@@ -1149,6 +1210,16 @@ class FsciProblem final : public run::Problem {
       const auto force = benchmark_force();
       series.add("drag", force[0]);
       series.add("lift", force[1]);
+      const auto& b = parameters_.benchmark;
+      if (b.statistics && time >= b.statistics_from) {
+        forces_.times.push_back(time);
+        forces_.values[0].push_back(force[0]);
+        forces_.values[1].push_back(force[1]);
+        if (probe_index_ >= 0) {
+          const auto u = find_solid(b.probe_solid)->model->probe_values()[probe_index_];
+          for (std::size_t i = 0; i < u.size(); ++i) forces_.values[2 + i].push_back(u[i]);
+        }
+      }
     }
     if (const auto* body = benchmark_body()) {
       series.add("drag_coefficient", coefficient_scale() * body->total_force[0]);
@@ -1181,6 +1252,10 @@ class FsciProblem final : public run::Problem {
     log::info("force balance: max |sum B^T lambda - sum reactions| / |sum reactions| = {:.3e}",
               force_balance_);
     if (b.type == "valve") valve_benchmark(json);
+    if (b.type == "forces" && b.statistics) {
+      forces_statistics(json);
+      return;
+    }
     if (b.type == "forces") {
       const auto force = benchmark_force();
       json["drag"] = force[0];
@@ -1224,6 +1299,51 @@ class FsciProblem final : public run::Problem {
         json["pressure_difference_error"] =
             std::abs(difference / b.reference_pressure_difference - 1);
     }
+  }
+
+  /// The `forces` benchmark of a transient run with statistics_from: drag, lift and the probe's
+  /// displacement_x, displacement_y (, _z) over their last full period among the recorded
+  /// steps (solid::last_period: mean = (max + min)/2, amplitude = (max − min)/2, frequency
+  /// from successive upward mid-level crossings), each as {mean, amplitude, frequency,
+  /// periods, final} with mean_error, amplitude_error, frequency_error = |value/reference − 1|
+  /// where the case gives the reference. null where fewer than two crossings were seen.
+  void forces_statistics(io::Json& json) const {
+    const auto& b = parameters_.benchmark;
+    struct Reference {
+      double mean, amplitude, frequency;
+    };
+    const std::vector<Reference> references = {
+        {b.reference_drag_force, b.reference_drag_amplitude, b.reference_drag_frequency},
+        {b.reference_lift_force, b.reference_lift_amplitude, b.reference_lift_frequency},
+        {b.reference_displacement_x, b.reference_displacement_x_amplitude,
+         b.reference_displacement_x_frequency},
+        {b.reference_displacement_y, b.reference_displacement_y_amplitude,
+         b.reference_displacement_y_frequency},
+        {0, 0, 0}};
+    const auto number = [](double x) { return std::isfinite(x) ? io::Json(x) : io::Json(); };
+    for (std::size_t q = 0; q < forces_.values.size(); ++q) {
+      const auto& values = forces_.values[q];
+      const auto summary = solid::last_period(forces_.times, values);
+      auto& entry = json[forces_.names[q]];
+      entry["mean"] = number(summary.mean);
+      entry["amplitude"] = number(summary.amplitude);
+      entry["frequency"] = number(summary.frequency);
+      entry["periods"] = summary.periods;
+      entry["final"] = values.empty() ? io::Json() : io::Json(values.back());
+      const auto& reference = references[q];
+      const auto error = [&](const char* key, double value, double published) {
+        if (published != 0 && std::isfinite(value)) entry[key] = std::abs(value / published - 1);
+      };
+      error("mean_error", summary.mean, reference.mean);
+      error("amplitude_error", summary.amplitude, reference.amplitude);
+      error("frequency_error", summary.frequency, reference.frequency);
+      log::info(
+          "{}: mean {:.6g}, amplitude {:.6g}, frequency {:.6g} Hz ({} full period(s) after "
+          "t = {:g} s)",
+          forces_.names[q], summary.mean, summary.amplitude, summary.frequency, summary.periods,
+          b.statistics_from);
+    }
+    json["statistics_from"] = b.statistics_from;
   }
 
   /// The fluid (with a `constrained` marker) and each solid with its force Bᵀλ.
@@ -1286,6 +1406,13 @@ class FsciProblem final : public run::Problem {
     double max_penetration = 0;
   } valve_;
   int probe_index_ = -1;  ///< benchmark.probe in its solid's probes
+  /// The `forces` benchmark's steps from statistics_from on: times and per quantity (drag,
+  /// lift, then the probe's displacement components) its values.
+  struct ForcesHistory {
+    std::vector<std::string> names;
+    std::vector<double> times;
+    std::vector<std::vector<double>> values;
+  } forces_;
   const run::CheckpointReader* restart_ = nullptr;
 };
 
