@@ -179,6 +179,10 @@ void ContactConstraints::update(Vec u, Vec residual) {
   COAPT_PETSC_CHECK(VecCopy(work_, residual));
 }
 
+bool ContactConstraints::prescribed(PetscInt dof) const {
+  return std::binary_search(dirichlet_.begin(), dirichlet_.end(), dof);
+}
+
 void ContactConstraints::add_gap_terms(Vec v, double sign) {
   for (const auto& pair : pairs_)
     for (int j = 0; j < pair.slave.n_nodes(); ++j) {
@@ -359,9 +363,6 @@ void ContactConstraints::build_row_operator() {
       if (pair.active[j])
         active_normal[pair.slave.global_vertex[j]] =
             pair.mortar.normals.data() + static_cast<std::size_t>(j) * dim_;
-  const auto prescribed = [&](PetscInt dof) {
-    return std::binary_search(dirichlet_.begin(), dirichlet_.end(), dof);
-  };
   std::vector<PetscInt> rows, columns;
   std::vector<double> values;
   for (PetscInt dof = first_dof_; dof < end_dof_; ++dof) {
@@ -464,9 +465,6 @@ Mat ContactConstraints::transform(Mat K, Vec rhs) {
   std::vector<PetscInt> rows, columns;
   std::vector<double> values;
   const double c = complementarity_constant_;
-  const auto prescribed = [&](PetscInt dof) {
-    return std::binary_search(dirichlet_.begin(), dirichlet_.end(), dof);
-  };
   // The derivative is taken once the active set holds (no node changed at this update): while
   // it is still being found, R is far from the contact forces it will balance and (dP/du) R
   // points the search astray.
@@ -579,9 +577,6 @@ void ContactConstraints::add_geometric_tangent(std::size_t p, std::vector<PetscI
     if (touches)
       for (int node : facet) slave_moves[node] = 1;
   }
-  const auto prescribed = [&](PetscInt dof) {
-    return std::binary_search(dirichlet_.begin(), dirichlet_.end(), dof);
-  };
   // Central differences of the terms over each free coordinate that moves.
   const double step = 1e-7 * reference_sizes_[p];
   std::vector<double> slave_x = pair.slave_x, master_x = pair.master_x;

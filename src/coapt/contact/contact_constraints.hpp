@@ -141,6 +141,8 @@ class ContactConstraints {
 
  private:
   void build_row_operator();
+  /// Whether owned dof `dof` (global number) is prescribed.
+  bool prescribed(PetscInt dof) const;
   /// v ← v + sign c n_j g̃_j at the free dofs of the active slave nodes (owned). Collective.
   void add_gap_terms(Vec v, double sign);
   /// The geometry-dependent part of pair p's transformed residual, P R − R − c n g̃ (R the
