@@ -1,7 +1,9 @@
 #!/usr/bin/python3
 """Plots a valve2d run: the leaflets (deformed solid mesh) at up to eight times of the solid's
 VTK series inside the channel near the valve (left), and over time the opening, the flow through
-the inlet and the inlet pressure (right), from RUN_DIR/solid.pvd and RUN_DIR/series.csv.
+the inlet, the leak (that flow less the flow the leaflets sweep out, where the case gives
+benchmark.upstream_surfaces) and the inlet pressure (right), from RUN_DIR/solid.pvd and
+RUN_DIR/series.csv.
 
     /usr/bin/python3 cases/valve2d/plot_valve.py OUT.png RUN_DIR
 """
@@ -62,6 +64,9 @@ def main():
     t = [row["time"] for row in rows]
     history.plot(t, [1e3 * row["opening_leaflets"] for row in rows], label="opening [mm]")
     history.plot(t, [-1e4 * row["outlet_flow_inlet"] for row in rows], label="flow in [cm²/s]")
+    if rows and "leak_flow" in rows[0]:
+        history.plot(t, [1e4 * row["leak_flow"] for row in rows], "--",
+                     label="leak: flow out − swept [cm²/s]")
     history.plot(t, [row["outlet_pressure_inlet"] / 10 for row in rows], label="inlet pressure [10 Pa]")
     closed = [row["contact_active_nodes_leaflets"] > 0 for row in rows]
     for i, c in enumerate(closed):

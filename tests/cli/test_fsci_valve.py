@@ -9,7 +9,8 @@ level 0, with the pressure reversed from the start so that the leaflets close (t
  - 2 ranks agree with 1 rank to the coupling tolerance (opening and flow to 1e-3 relative);
  - IQN-ILS needs fewer than half the coupling iterations of Aitken's relaxation over the
    first 5 steps (the added-mass effect of leaflets barely heavier than the fluid);
- - a valve benchmark naming a solid without contact is an input error naming the key."""
+ - a valve benchmark naming a solid without contact is an input error naming the key, and so
+   is an upstream surface the solid does not have."""
 
 from cli_common import Runner, parse_arguments, run_with_series
 
@@ -61,6 +62,12 @@ def main():
                    "--set", "benchmark.solid=valve")
     r.expect(result.returncode == 2 and "benchmark.solid" in result.stderr,
              "a valve benchmark without such a solid is an input error naming the key", result.stderr)
+    result = r.run("run", r.source / "cases" / "valve2d.yaml", "--output", r.work / "bad-surface",
+                   "--set", "benchmark.upstream_surfaces=[lower_inner, upper_side]")
+    r.expect(result.returncode == 2 and "benchmark.upstream_surfaces" in result.stderr
+             and "upper_side" in result.stderr and "upper_inner" in result.stderr,
+             "an upstream surface the leaflets do not have is an input error naming the key, the "
+             "group and the groups there are", result.stderr)
     r.finish()
 
 

@@ -11,10 +11,12 @@ namespace coapt {
 /// Prints (through the log, rank 0) one line per completed step.
 class Progress {
  public:
-  /// `n_steps` steps ending at `end_time` [s] of simulated time.
-  Progress(int n_steps, double end_time);
+  /// `n_steps` steps (planned) from `start_time` to `end_time` [s] of simulated time.
+  Progress(int n_steps, double end_time, double start_time = 0.0);
   /// Reports step `step` (1-based) completed at simulated time `time`; `iterations` is a
-  /// short free text ("newton 3, ksp 41").
+  /// short free text ("newton 3, ksp 41"). The time left is estimated from the simulated time
+  /// still to go; a step beyond the planned count (a driver that shortened its steps) raises
+  /// the count shown.
   void step(int step, double time, const std::string& iterations);
   /// Wall time since construction [s].
   double elapsed() const;
@@ -22,6 +24,7 @@ class Progress {
  private:
   int n_steps_;
   double end_time_;
+  double start_time_;
   std::chrono::steady_clock::time_point start_;
 };
 

@@ -75,6 +75,9 @@ struct Benchmark {
   std::vector<double> pressure_points;  ///< x_A, y_A, x_B, y_B: Δp = p(A) − p(B)
   // valve: the solid whose contact closes it and the boundary group whose flow is the leak
   std::string valve_solid, flow_boundary;
+  /// valve: the solid's boundary groups that face flow_boundary's side of the closed valve;
+  /// their swept flux is taken from the flow to give the leak (empty: the flow is the leak)
+  std::vector<std::string> upstream_surfaces;
   double reference_drag = 0, reference_lift = 0, reference_pressure_difference = 0;
 };
 
@@ -212,6 +215,13 @@ Parameters read(const config::Section& root) {
         "solid", {"", "the deformable solid with contact whose closing is measured"});
     b.flow_boundary = benchmark.require<std::string>(
         "flow_boundary", {"", "fluid boundary group whose flow (out of the fluid) is the leak"});
+    b.upstream_surfaces = benchmark.get<std::vector<std::string>>(
+        "upstream_surfaces", {},
+        {"",
+         "boundary groups of the solid that face flow_boundary's side of the closed valve: "
+         "the rate at which they sweep that side (their flux of the solid velocity) is taken "
+         "from the flow, so that the leak excludes the fluid the moving leaflets push out; "
+         "empty: the leak is the whole flow"});
     const auto found = std::find_if(p.solids.begin(), p.solids.end(),
                                     [&](const SolidEntry& s) { return s.name == b.valve_solid; });
     if (found == p.solids.end() || !found->contact.enabled())
@@ -392,8 +402,20 @@ class FsciProblem final : public run::Problem {
       throw InputError("benchmark.pressure_points: the pressure probes are a 2D quantity");
     for (const auto& group : b.boundaries)
       boundary_tags_.push_back(fluid_.boundary_tag(group, "benchmark.boundaries"));
-    if (b.type == "valve")
+    if (b.type == "valve") {
       flow_tag_ = fluid_.boundary_tag(b.flow_boundary, "benchmark.flow_boundary");
+      const auto& solid_mesh = find_solid(b.valve_solid)->mesh;
+      for (const auto& group : b.upstream_surfaces) {
+        const auto* found = solid_mesh.find_group(group);
+        if (found && found->dim == solid_mesh.dim - 1) continue;
+        std::string names;
+        for (const auto& g : solid_mesh.groups)
+          if (g.dim == solid_mesh.dim - 1) names += (names.empty() ? "" : ", ") + g.name;
+        throw InputError(fmt::format(
+            "benchmark.upstream_surfaces: solid '{}' has no boundary group '{}' (it has: {})",
+            b.valve_solid, group, names.empty() ? "none" : names));
+      }
+    }
     if (!b.probe.empty()) {
       const Solid* owner = find_solid(b.probe_solid);
       if (!owner || !owner->model)
@@ -517,12 +539,12 @@ class FsciProblem final : public run::Problem {
       coupling_total = report.coupling.iterations;
       record_step(output, 0.0, report.coupling);
     } else {
-      Progress progress(p.time.n_steps(), p.time.end_time);
       int step = 0;
       if (restart_) {
         step = n_steps_done = read_checkpoint(*restart_);
         log::info("continuing after step {} (t = {:g} s)", step, fluid_.time());
       }
+      Progress progress(p.time.n_steps(), p.time.end_time, fluid_.time());
       while (fluid_.time() < p.time.end_time * (1 - 1e-12)) {
         const double dt = std::min(p.time.time_step, p.time.end_time - fluid_.time());
         CouplingReport report;
@@ -551,7 +573,7 @@ class FsciProblem final : public run::Problem {
           write_checkpoint(output, step);
         }
         progress.step(
-            std::min(step, p.time.n_steps()), fluid_.time(),
+            step, fluid_.time(),
             fmt::format("coupling {}, newton {}", report.iterations, report.newton_iterations));
       }
     }
@@ -626,6 +648,7 @@ class FsciProblem final : public run::Problem {
     valve["times"] = io::Json::array_of(valve_.times);
     valve["opening"] = io::Json::array_of(valve_.opening);
     valve["flow"] = io::Json::array_of(valve_.flow);
+    valve["swept"] = io::Json::array_of(valve_.swept);
     valve["closed"] =
         io::Json::array_of(std::vector<int>(valve_.closed.begin(), valve_.closed.end()));
     valve["max_penetration"] = valve_.max_penetration;
@@ -686,6 +709,9 @@ class FsciProblem final : public run::Problem {
     valve_.times = doubles(valve.at("times"));
     valve_.opening = doubles(valve.at("opening"));
     valve_.flow = doubles(valve.at("flow"));
+    // absent from checkpoints written before it: no swept flow
+    valve_.swept = valve.contains("swept") ? doubles(valve.at("swept"))
+                                           : std::vector<double>(valve_.flow.size(), 0.0);
     for (const auto& value : valve.at("closed").as_array())
       valve_.closed.push_back(value.as_int() != 0 ? 1 : 0);
     valve_.max_penetration = valve.at("max_penetration").as_double();
@@ -1108,13 +1134,24 @@ class FsciProblem final : public run::Problem {
     valve_.opening.push_back(opening);
     valve_.closed.push_back(status.active > 0 ? 1 : 0);
     valve_.flow.push_back(fluid_.navier_stokes().boundary_flow(flow_tag_));
+    valve_.swept.push_back(swept_flow(solid));
     valve_.max_penetration = std::max(valve_.max_penetration, status.max_penetration);
   }
 
-  /// Closed phases (runs of steps with contact), the volume through flow_boundary in each
-  /// (Σ Q Δt over its steps), the extremes of the opening and the largest penetration.
+  /// The rate at which benchmark.upstream_surfaces of the valve's solid sweep the fluid on the
+  /// flow boundary's side: Σ ∫ v·n over them (n out of the solid). Collective.
+  double swept_flow(const Solid& solid) const {
+    double swept = 0;
+    for (const auto& group : parameters_.benchmark.upstream_surfaces)
+      swept += solid.model->surface_flux(group);
+    return swept;
+  }
+
+  /// Closed phases (runs of steps with contact), in each the volume through flow_boundary
+  /// (Σ Q Δt over its steps) and the leak (Σ (Q − swept) Δt), the extremes of the opening and
+  /// the largest penetration.
   void valve_benchmark(io::Json& json) const {
-    std::vector<double> leak, phase_start, phase_end;
+    std::vector<double> leak, outflow, phase_start, phase_end;
     double largest = 0, smallest = std::numeric_limits<double>::infinity();
     for (std::size_t k = 0; k < valve_.times.size(); ++k) {
       if (std::isfinite(valve_.opening[k])) {
@@ -1125,24 +1162,27 @@ class FsciProblem final : public run::Problem {
       const double dt = k > 0 ? valve_.times[k] - valve_.times[k - 1] : 0.0;
       if (k == 0 || !valve_.closed[k - 1]) {
         leak.push_back(0.0);
+        outflow.push_back(0.0);
         phase_start.push_back(valve_.times[k]);
         phase_end.push_back(valve_.times[k]);
       }
-      leak.back() += valve_.flow[k] * dt;
+      leak.back() += (valve_.flow[k] - valve_.swept[k]) * dt;
+      outflow.back() += valve_.flow[k] * dt;
       phase_end.back() = valve_.times[k];
     }
     json["closed_phases"] = static_cast<std::int64_t>(leak.size());
     json["closed_phase_start"] = io::Json::array_of(phase_start);
     json["closed_phase_end"] = io::Json::array_of(phase_end);
     json["leak_volume"] = io::Json::array_of(leak);
+    json["outflow_volume"] = io::Json::array_of(outflow);
     json["max_penetration"] = valve_.max_penetration;
     json["max_opening"] = largest;
     json["min_opening"] = std::isfinite(smallest) ? smallest : 0.0;
     log::info(
-        "valve: {} closed phase(s), leak volume {} m^2 (2D) / m^3, opening in [{:.4e}, "
-        "{:.4e}] m, max penetration {:.3e} m",
-        leak.size(), fmt::join(leak, ", "), json["min_opening"].as_double(), largest,
-        valve_.max_penetration);
+        "valve: {} closed phase(s), leak volume {} (outflow {}) m^2 (2D) / m^3, opening in "
+        "[{:.4e}, {:.4e}] m, max penetration {:.3e} m",
+        leak.size(), fmt::join(leak, ", "), fmt::join(outflow, ", "),
+        json["min_opening"].as_double(), largest, valve_.max_penetration);
   }
 
   /// c = 2F/(ρŪ²D) of the benchmark body.
@@ -1204,7 +1244,10 @@ class FsciProblem final : public run::Problem {
                                  ? std::numeric_limits<double>::quiet_NaN()
                                  : contact::surface_distance(pairs[0]);
       series.add("opening_" + name, opening);
-      if (name == parameters_.benchmark.valve_solid) record_valve(time, opening, *solid);
+      if (name != parameters_.benchmark.valve_solid) continue;
+      record_valve(time, opening, *solid);
+      series.add("swept_flow", valve_.swept.back());
+      series.add("leak_flow", valve_.flow.back() - valve_.swept.back());
     }
     if (parameters_.benchmark.type == "forces") {
       const auto force = benchmark_force();
@@ -1402,6 +1445,7 @@ class FsciProblem final : public run::Problem {
   int flow_tag_ = -1;                                   ///< benchmark.flow_boundary (valve)
   struct ValveHistory {
     std::vector<double> times, opening, flow;
+    std::vector<double> swept;  ///< the upstream surfaces' swept flow (0 without them)
     std::vector<char> closed;
     double max_penetration = 0;
   } valve_;

@@ -34,11 +34,30 @@ SolveStats LinearSolver::solve(Vec rhs, Vec solution) {
   COAPT_PETSC_CHECK(KSPGetResidualNorm(ksp_, &residual));
   SolveStats stats{static_cast<int>(iterations), static_cast<double>(residual),
                    KSPConvergedReasons[reason]};
+  if (reason == KSP_DIVERGED_PC_FAILED) reset_factorisation();
   if (reason < 0)
     throw ConvergenceError(fmt::format(
         "linear solver -{} did not converge: {} after {} iterations, residual norm {:.3e}", prefix_,
         stats.reason, stats.iterations, stats.residual_norm));
   return stats;
+}
+
+void LinearSolver::reset_factorisation() {
+  PC pc = nullptr;
+  COAPT_PETSC_CHECK(KSPGetPC(ksp_, &pc));
+  PetscBool factor = PETSC_FALSE;
+  COAPT_PETSC_CHECK(
+      PetscObjectTypeCompareAny(reinterpret_cast<PetscObject>(pc), &factor, PCLU, PCCHOLESKY, ""));
+  if (!factor) return;
+  // PCReset drops the operators with the factor: keep them alive and set them again.
+  Mat matrix = nullptr, preconditioner = nullptr;
+  COAPT_PETSC_CHECK(KSPGetOperators(ksp_, &matrix, &preconditioner));
+  COAPT_PETSC_CHECK(PetscObjectReference(reinterpret_cast<PetscObject>(matrix)));
+  COAPT_PETSC_CHECK(PetscObjectReference(reinterpret_cast<PetscObject>(preconditioner)));
+  COAPT_PETSC_CHECK(PCReset(pc));
+  COAPT_PETSC_CHECK(KSPSetOperators(ksp_, matrix, preconditioner));
+  COAPT_PETSC_CHECK(MatDestroy(&matrix));
+  COAPT_PETSC_CHECK(MatDestroy(&preconditioner));
 }
 
 std::string LinearSolver::describe() const {

@@ -34,12 +34,17 @@ class LinearSolver {
   /// Sets (or resets after re-assembly) the operator; the preconditioner is rebuilt.
   void set_operator(Mat matrix);
   /// Solves A x = b; throws ConvergenceError naming the prefix, the reason and the iterations.
+  /// A failed factorisation (LU, Cholesky) is discarded first, so that the next solve analyses
+  /// and factors afresh: MUMPS refuses every later numeric factorisation of an instance whose
+  /// last one failed, which would make a retried step fail at its first solve whatever its
+  /// matrix.
   SolveStats solve(Vec rhs, Vec solution);
   KSP ksp() const { return ksp_.get(); }
   /// A one-line description ("cg + gamg").
   std::string describe() const;
 
  private:
+  void reset_factorisation();
   OwnedKSP ksp_;
   std::string prefix_;
 };

@@ -194,13 +194,13 @@ class FlowProblem final : public run::Problem {
       record_step(output, 0.0, report);
     } else {
       const int n_steps = p.time.n_steps();
-      Progress progress(n_steps, p.time.end_time);
       int first_step = 1;
       if (restart_) {
         read_checkpoint(*restart_);
         first_step = model_.steps() + 1;
         log::info("continuing after step {} (t = {:g} s)", model_.steps(), model_.time());
       }
+      Progress progress(n_steps, p.time.end_time, model_.time());
       for (int step = first_step; step <= n_steps; ++step) {
         const double dt = std::min(p.time.time_step, p.time.end_time - model_.time());
         model_.begin_step(dt);

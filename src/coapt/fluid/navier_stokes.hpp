@@ -36,6 +36,9 @@ struct FluidParameters {
   double newton_relative_tolerance = 1e-8;          ///< ‖R‖ ≤ rtol ‖R₀‖ ...
   double newton_absolute_tolerance = 1e-10;         ///< ... or ‖R‖ ≤ atol
   int newton_max_iterations = 25;
+  /// Halvings of a Newton correction that raises ‖R‖ (backtracking while ‖R‖ stays above
+  /// the last iterate's; the trial with the smallest ‖R‖ is kept); 0: full corrections.
+  int newton_line_search = 0;
 };
 
 /// The time discretisation of one solve: steady (time_step ≤ 0) or a BDF step with
@@ -125,6 +128,10 @@ class NavierStokes {
   void assemble_system(const TimeLevel& time);
   /// ‖R‖ over the free dofs (a copy with Dirichlet rows zeroed goes into free_residual_).
   double free_residual_norm();
+  /// fluid.newton.line_search: state_ just took the full correction_ from an iterate whose
+  /// free residual norm was `previous`; halves it while ‖R‖ stays above that (at most
+  /// line_search times) and keeps the trial with the smallest finite ‖R‖.
+  void backtrack(const TimeLevel& time, double previous);
   std::vector<PetscInt> all_fixed_dofs() const;
   /// b with b_(v,i) = ∫_Γ φ_v n_i over the owned-cell facets tagged `tag` (pressure entries 0),
   /// so that Q = bᵀx for P1 velocities.

@@ -592,6 +592,54 @@ class SolidModelImpl {
     return motions;
   }
 
+  double surface_flux(const std::string& boundary) const {
+    const int tag = facet_tag(boundary, "surface_flux");
+    fem::update_ghosts(u_.get());
+    fem::update_ghosts(v_.get());
+    fem::LocalValues displacement(u_.get()), velocity(v_.get());
+    const auto x = [&](int vertex, int i) {
+      const auto k = static_cast<std::size_t>(vertex) * static_cast<std::size_t>(dim_) +
+                     static_cast<std::size_t>(i);
+      return mesh_.coordinates[k] + displacement[k];
+    };
+    double flux = 0;
+    for (int f = 0; f < mesh_.n_facets(); ++f) {
+      if (mesh_.facet_tags[f] != tag || mesh_.facet_cell[f] >= mesh_.n_owned_cells) continue;
+      const int* v = mesh_.facets.data() + static_cast<std::size_t>(f) * dim_;
+      // |F| n in the current configuration: the edge's normal in 2D, half the cross product
+      // of two edges in 3D.
+      double area_normal[3] = {};
+      if (dim_ == 2) {
+        area_normal[0] = x(v[1], 1) - x(v[0], 1);
+        area_normal[1] = -(x(v[1], 0) - x(v[0], 0));
+      } else {
+        double e1[3], e2[3];
+        for (int i = 0; i < 3; ++i) {
+          e1[i] = x(v[1], i) - x(v[0], i);
+          e2[i] = x(v[2], i) - x(v[0], i);
+        }
+        area_normal[0] = 0.5 * (e1[1] * e2[2] - e1[2] * e2[1]);
+        area_normal[1] = 0.5 * (e1[2] * e2[0] - e1[0] * e2[2]);
+        area_normal[2] = 0.5 * (e1[0] * e2[1] - e1[1] * e2[0]);
+      }
+      // Outward: away from the cell's vertex off the facet.
+      double inward = 0;
+      for (const int w : mesh_.cell(mesh_.facet_cell[f]))
+        if (std::find(v, v + dim_, w) == v + dim_)
+          for (int i = 0; i < dim_; ++i) inward += area_normal[i] * (x(w, i) - x(v[0], i));
+      const double sign = inward > 0 ? -1.0 : 1.0;
+      // ∫_F v·n = |F| n · (mean of the vertex velocities): exact for P1 on a flat facet.
+      for (int a = 0; a < dim_; ++a)
+        for (int i = 0; i < dim_; ++i)
+          flux += sign * area_normal[i] *
+                  velocity[static_cast<std::size_t>(v[a]) * static_cast<std::size_t>(dim_) +
+                           static_cast<std::size_t>(i)] /
+                  dim_;
+    }
+    MPI_Allreduce(MPI_IN_PLACE, &flux, 1, MPI_DOUBLE, MPI_SUM, comm_);
+    return flux;
+  }
+
   std::vector<double> current_coordinates() const {
     fem::LocalValues values(u_.get());
     std::vector<double> coordinates = mesh_.coordinates;
@@ -1466,6 +1514,8 @@ class SolidModelImpl {
         throw ConvergenceError(
             fmt::format("solid: {}: every Newton step inverts a cell (|R| history [{:.3e}]); {}",
                         where, fmt::join(history, ", "), remedy));
+      if (newton.line_search > 0 && norm > history.back())
+        norm = backtrack(update, step_length, norm, history.back(), residual_norm);
       history.push_back(norm);
       accepted = !hook_ || hook_->accept(u_.get());
       PetscReal update_norm = 0, u_norm = 0;
@@ -1482,6 +1532,34 @@ class SolidModelImpl {
       else
         log::debug("{}", line);
     }
+  }
+
+  /// newton.line_search: u_ = u_old + `step_length` δu raised |R| to `norm` above `previous`.
+  /// Halves the step while |R| stays above `previous` (at most line_search times), then sets
+  /// u_ to the trial with the smallest finite |R| and re-evaluates R there (residual_, ghosts
+  /// and the hook's state follow u_). Returns that |R|; `step_length` is the step kept.
+  template <class ResidualNorm>
+  double backtrack(Vec update, double& step_length, double norm, double previous,
+                   ResidualNorm&& residual_norm) {
+    double best_norm = norm, best_length = step_length;
+    for (int k = 0; k < parameters_.newton.line_search && norm > previous; ++k) {
+      const double next = 0.5 * step_length;
+      COAPT_PETSC_CHECK(VecAXPY(u_, next - step_length, update));
+      step_length = next;
+      fem::update_ghosts(u_);
+      norm = residual_norm();
+      if (std::isfinite(norm) && norm < best_norm) {
+        best_norm = norm;
+        best_length = step_length;
+      }
+    }
+    if (step_length != best_length) {
+      COAPT_PETSC_CHECK(VecAXPY(u_, best_length - step_length, update));
+      step_length = best_length;
+      fem::update_ghosts(u_);
+      norm = residual_norm();
+    }
+    return norm;
   }
 
   // --- output --------------------------------------------------------------------------------
@@ -1676,6 +1754,9 @@ std::array<double, 9> SolidModel::mean_cauchy_stress() const {
 }
 std::vector<double> SolidModel::reaction_force(const std::string& boundary) const {
   return impl_->reaction_force(boundary);
+}
+double SolidModel::surface_flux(const std::string& boundary) const {
+  return impl_->surface_flux(boundary);
 }
 std::vector<double> SolidModel::current_coordinates() const {
   return impl_->current_coordinates();

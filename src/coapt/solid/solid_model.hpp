@@ -204,6 +204,11 @@ class SolidModel {
   /// force the supports exert on the body, per unit thickness in 2D) [N], dim() components.
   /// InputError when the group does not exist. Collective.
   std::vector<double> reaction_force(const std::string& boundary) const;
+  /// The flux of the trial velocity through a boundary group in the current configuration,
+  /// ∫_Γ v·n da with n the outward normal of the body [m³/s, or m²/s in 2D]: the rate at which
+  /// that surface sweeps the space outside the body. InputError when the group does not
+  /// exist. Collective.
+  double surface_flux(const std::string& boundary) const;
   /// The current coordinates X + u of the local vertices (owned and ghost), row-major.
   std::vector<double> current_coordinates() const;
 

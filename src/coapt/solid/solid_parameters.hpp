@@ -30,7 +30,7 @@
 ///   impacts: {body: ball}              dynamics with contact: rebound angles and energy loss
 ///                                      of each impact of that body (solid_problem.cpp)
 ///   newton: {relative_tolerance, absolute_tolerance, update_tolerance, max_iterations,
-///            predictor: previous | extrapolate}
+///            predictor: previous | extrapolate, line_search: 0}
 ///   probes: [{name: tip, point: [0.048, 0.060]}]
 ///   reactions: [base, top]             boundary groups whose reaction force is reported
 ///   uniaxial_reference: {axis: [1, 0, 0], reaction_boundary: right, reference_area: 1e-6}
@@ -120,6 +120,10 @@ struct NewtonParameters {
   /// extrapolation (a new loading phase), one linearised step carries the difference into the
   /// body first (counted as a Newton iteration).
   bool extrapolate = false;
+  /// `line_search: N` (0: off): when an update raises ‖R‖, it is halved up to N times while
+  /// ‖R‖ stays above the last iterate's, and the trial with the smallest ‖R‖ is kept (each
+  /// trial re-evaluates R, contact terms and active set included).
+  int line_search = 0;
 };
 
 /// Time integration: `static` (load stepping, the default), `newmark` (β = 1/4, γ = 1/2) or

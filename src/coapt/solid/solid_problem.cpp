@@ -393,7 +393,7 @@ class SolidProblem final : public run::Problem {
     };
 
     int total_newton = 0, total_linear = 0;
-    Progress progress(time.n_steps, time.end_time);
+    Progress progress(time.n_steps, time.end_time, (first_step - 1) * time.step);
     for (int step = first_step; step <= time.n_steps; ++step) {
       const double t = step * time.step;
       const auto report = solid_.step(t, time.step, output);
