@@ -6,11 +6,11 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <optional>
 
 #include "coapt/core/error.hpp"
 #include "coapt/core/log.hpp"
+#include "coapt/fem/line_search.hpp"
 #include "coapt/fem/p1.hpp"
 #include "coapt/fluid/kernels.hpp"
 
@@ -566,35 +566,28 @@ NewtonReport NavierStokes::solve(const TimeLevel& time, const std::string& label
     }
     COAPT_PETSC_CHECK(VecAXPY(state_, 1.0, correction_));
     fem::update_ghosts(state_);
-    if (parameters_.newton_line_search > 0) backtrack(time, norm);
+    if (parameters_.newton_line_search > 0) {
+      // newton.line_search: halve the correction while it raises ‖R‖ (fem/line_search.hpp)
+      const auto evaluate = [&] {
+        assemble_residual(time);
+        return free_residual_norm();
+      };
+      const double raised = evaluate();
+      if (!(raised <= norm)) {
+        const auto kept = fem::backtrack(
+            parameters_.newton_line_search, 1.0, raised, norm,
+            [&](double from, double to) {
+              COAPT_PETSC_CHECK(VecAXPY(state_, to - from, correction_));
+              fem::update_ghosts(state_);
+            },
+            evaluate);
+        log::debug("fluid Newton: correction scaled by {:g} (|R| {:.3e} -> {:.3e})", kept.length,
+                   norm, kept.norm);
+      }
+    }
     report.iterations = iteration + 1;
   }
   return report;
-}
-
-void NavierStokes::backtrack(const TimeLevel& time, double previous) {
-  assemble_residual(time);
-  double norm = free_residual_norm(), length = 1.0;
-  double best_norm = std::isfinite(norm) ? norm : std::numeric_limits<double>::infinity();
-  double best_length = 1.0;
-  for (int k = 0; k < parameters_.newton_line_search && !(norm <= previous); ++k) {
-    COAPT_PETSC_CHECK(VecAXPY(state_, -0.5 * length, correction_));
-    length *= 0.5;
-    fem::update_ghosts(state_);
-    assemble_residual(time);
-    norm = free_residual_norm();
-    if (std::isfinite(norm) && norm < best_norm) {
-      best_norm = norm;
-      best_length = length;
-    }
-  }
-  if (length != best_length) {
-    COAPT_PETSC_CHECK(VecAXPY(state_, best_length - length, correction_));
-    fem::update_ghosts(state_);
-  }
-  if (best_length != 1.0)
-    log::debug("fluid Newton: correction scaled by {:g} (|R| {:.3e} -> {:.3e})", best_length,
-               previous, best_norm);
 }
 
 std::vector<double> NavierStokes::boundary_force(int tag, const TimeLevel& time) {

@@ -128,10 +128,6 @@ class NavierStokes {
   void assemble_system(const TimeLevel& time);
   /// ‖R‖ over the free dofs (a copy with Dirichlet rows zeroed goes into free_residual_).
   double free_residual_norm();
-  /// fluid.newton.line_search: state_ just took the full correction_ from an iterate whose
-  /// free residual norm was `previous`; halves it while ‖R‖ stays above that (at most
-  /// line_search times) and keeps the trial with the smallest finite ‖R‖.
-  void backtrack(const TimeLevel& time, double previous);
   std::vector<PetscInt> all_fixed_dofs() const;
   /// b with b_(v,i) = ∫_Γ φ_v n_i over the owned-cell facets tagged `tag` (pressure entries 0),
   /// so that Q = bᵀx for P1 velocities.

@@ -23,6 +23,7 @@
 #include "coapt/core/timer.hpp"
 #include "coapt/fem/assembly.hpp"
 #include "coapt/fem/kernels.hpp"
+#include "coapt/fem/line_search.hpp"
 #include "coapt/fem/linear_solver.hpp"
 #include "coapt/fem/p1.hpp"
 #include "coapt/mesh/mesh_input.hpp"
@@ -1514,8 +1515,18 @@ class SolidModelImpl {
         throw ConvergenceError(
             fmt::format("solid: {}: every Newton step inverts a cell (|R| history [{:.3e}]); {}",
                         where, fmt::join(history, ", "), remedy));
-      if (newton.line_search > 0 && norm > history.back())
-        norm = backtrack(update, step_length, norm, history.back(), residual_norm);
+      if (newton.line_search > 0 && norm > history.back()) {
+        // newton.line_search: halve the update while it raises |R| (fem/line_search.hpp)
+        const auto kept = fem::backtrack(
+            newton.line_search, step_length, norm, history.back(),
+            [&](double from, double to) {
+              COAPT_PETSC_CHECK(VecAXPY(u_, to - from, update));
+              fem::update_ghosts(u_);
+            },
+            residual_norm);
+        norm = kept.norm;
+        step_length = kept.length;
+      }
       history.push_back(norm);
       accepted = !hook_ || hook_->accept(u_.get());
       PetscReal update_norm = 0, u_norm = 0;
@@ -1532,34 +1543,6 @@ class SolidModelImpl {
       else
         log::debug("{}", line);
     }
-  }
-
-  /// newton.line_search: u_ = u_old + `step_length` δu raised |R| to `norm` above `previous`.
-  /// Halves the step while |R| stays above `previous` (at most line_search times), then sets
-  /// u_ to the trial with the smallest finite |R| and re-evaluates R there (residual_, ghosts
-  /// and the hook's state follow u_). Returns that |R|; `step_length` is the step kept.
-  template <class ResidualNorm>
-  double backtrack(Vec update, double& step_length, double norm, double previous,
-                   ResidualNorm&& residual_norm) {
-    double best_norm = norm, best_length = step_length;
-    for (int k = 0; k < parameters_.newton.line_search && norm > previous; ++k) {
-      const double next = 0.5 * step_length;
-      COAPT_PETSC_CHECK(VecAXPY(u_, next - step_length, update));
-      step_length = next;
-      fem::update_ghosts(u_);
-      norm = residual_norm();
-      if (std::isfinite(norm) && norm < best_norm) {
-        best_norm = norm;
-        best_length = step_length;
-      }
-    }
-    if (step_length != best_length) {
-      COAPT_PETSC_CHECK(VecAXPY(u_, best_length - step_length, update));
-      step_length = best_length;
-      fem::update_ghosts(u_);
-      norm = residual_norm();
-    }
-    return norm;
   }
 
   // --- output --------------------------------------------------------------------------------
