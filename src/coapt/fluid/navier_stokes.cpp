@@ -523,9 +523,13 @@ NewtonReport NavierStokes::solve(const TimeLevel& time, const std::string& label
   NewtonReport report;
   const auto fixed = all_fixed_dofs();
   double initial = 0;
+  // ‖R‖ of the current state when the line search has already assembled it (free_residual_
+  // holds it too)
+  std::optional<double> evaluated;
   for (int iteration = 0;; ++iteration) {
-    assemble_residual(time);
-    const double norm = free_residual_norm();
+    if (!evaluated) assemble_residual(time);
+    const double norm = evaluated ? *evaluated : free_residual_norm();
+    evaluated.reset();
     report.residual_history.push_back(norm);
     if (!std::isfinite(norm))
       throw ConvergenceError(fmt::format("fluid Newton, {}: non-finite residual (history {})",
@@ -572,10 +576,10 @@ NewtonReport NavierStokes::solve(const TimeLevel& time, const std::string& label
         assemble_residual(time);
         return free_residual_norm();
       };
-      const double raised = evaluate();
-      if (!(raised <= norm)) {
+      evaluated = evaluate();
+      if (!(*evaluated <= norm)) {
         const auto kept = fem::backtrack(
-            parameters_.newton_line_search, 1.0, raised, norm,
+            parameters_.newton_line_search, 1.0, *evaluated, norm,
             [&](double from, double to) {
               COAPT_PETSC_CHECK(VecAXPY(state_, to - from, correction_));
               fem::update_ghosts(state_);
@@ -583,6 +587,7 @@ NewtonReport NavierStokes::solve(const TimeLevel& time, const std::string& label
             evaluate);
         log::debug("fluid Newton: correction scaled by {:g} (|R| {:.3e} -> {:.3e})", kept.length,
                    norm, kept.norm);
+        evaluated = kept.norm;
       }
     }
     report.iterations = iteration + 1;

@@ -607,8 +607,8 @@ class SolidModelImpl {
     for (int f = 0; f < mesh_.n_facets(); ++f) {
       if (mesh_.facet_tags[f] != tag || mesh_.facet_cell[f] >= mesh_.n_owned_cells) continue;
       const int* v = mesh_.facets.data() + static_cast<std::size_t>(f) * dim_;
-      // |F| n in the current configuration: the edge's normal in 2D, half the cross product
-      // of two edges in 3D.
+      // |F| n in the current configuration, n out of the body by the facets' orientation
+      // (mesh.hpp): the edge turned clockwise in 2D, half the cross product of two edges in 3D.
       double area_normal[3] = {};
       if (dim_ == 2) {
         area_normal[0] = x(v[1], 1) - x(v[0], 1);
@@ -623,16 +623,10 @@ class SolidModelImpl {
         area_normal[1] = 0.5 * (e1[2] * e2[0] - e1[0] * e2[2]);
         area_normal[2] = 0.5 * (e1[0] * e2[1] - e1[1] * e2[0]);
       }
-      // Outward: away from the cell's vertex off the facet.
-      double inward = 0;
-      for (const int w : mesh_.cell(mesh_.facet_cell[f]))
-        if (std::find(v, v + dim_, w) == v + dim_)
-          for (int i = 0; i < dim_; ++i) inward += area_normal[i] * (x(w, i) - x(v[0], i));
-      const double sign = inward > 0 ? -1.0 : 1.0;
       // ∫_F v·n = |F| n · (mean of the vertex velocities): exact for P1 on a flat facet.
       for (int a = 0; a < dim_; ++a)
         for (int i = 0; i < dim_; ++i)
-          flux += sign * area_normal[i] *
+          flux += area_normal[i] *
                   velocity[static_cast<std::size_t>(v[a]) * static_cast<std::size_t>(dim_) +
                            static_cast<std::size_t>(i)] /
                   dim_;
