@@ -43,7 +43,9 @@ def keys_of(coapt, case):
     if result.returncode != 0:
         return None, result.stderr
     rows = [line for line in result.stdout.splitlines() if line.startswith("| `")]
-    problem = open(case).read().split("problem:")[1].split()[0]
+    # the top-level key (a comment may say "problem:" too)
+    problem = next(line.split(":", 1)[1].split("#")[0].strip()
+                   for line in open(case) if line.startswith("problem:"))
     return problem, rows
 
 

@@ -10,7 +10,7 @@ so the plots can be redrawn from any set of runs without re-running anything.
 
        for l in 0 1 2 3; do
          OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 \\
-         mpirun --oversubscribe --bind-to none -np 2 build-lead/coapt run cases/cook/linear.yaml \\
+         mpirun --oversubscribe --bind-to none -np 2 build/coapt run cases/cook/linear.yaml \\
            --output /tmp/verif/cooklin-L$l --set mesh.level=$l --set output.vtk=false
        done
 

@@ -1,15 +1,17 @@
 #!/usr/bin/python3
 """Checkpoint and restart of the immersed coupling (`coapt run CASE --restart DIR`,
 coupling/fsci_problem.cpp write_checkpoint), on the 2D valve (cases/valve2d.yaml, level 0,
-pressure reversed from the start as in test_fsci_valve.py, 6 steps of 2 ms): leaflets by
+pressure reversed from the start as in test_fsci_valve.py, 22 steps of 2 ms): leaflets by
 contact-stabilized Newmark with mortar contact, IQN-ILS reusing the last 4 steps' columns.
 
-- 3 steps writing a checkpoint at step 3, restarted to step 6 on the same 2 ranks, gives the
-  rows of steps 4..6 of series.csv (forces, coupling iterations and changes, opening, contact,
-  flows) and the summary's benchmark bit for bit as the run of 6 steps straight through: the
-  fluid's BDF2 history, the leaflets' Newmark state, the applied force that starts a step, the
-  constrained fluid nodes, the contact active set and the IQN-ILS columns all come back;
-- restarted on 1 rank (another partition), step 6 agrees to 1e-5 relative in the opening and
+- 20 steps writing a checkpoint at step 20, when the coaptation faces are in contact (they
+  touch at t = 0.038 s), restarted to step 22 on the same 2 ranks, gives the rows of steps
+  21..22 of series.csv (forces, coupling iterations and changes, opening, contact nodes,
+  pressure and penetration, flows) and the summary's benchmark bit for bit as the run of 22
+  steps straight through: the fluid's BDF2 history, the leaflets' Newmark state, the applied
+  force that starts a step, the constrained fluid nodes, the contact active set and the
+  complementarity constant and the IQN-ILS columns all come back;
+- restarted on 1 rank (another partition), step 22 agrees to 1e-5 relative in the opening and
   the inlet flow (the coupling stops at a relative change of 1e-3, so its iterates differ by
   round-off from the 2-rank run's);
 - a rigid body translating through the fluid (cases/dfg/2d1_immersed.yaml made transient, the
@@ -28,7 +30,7 @@ from cli_common import (DETERMINISTIC_FLUID, DETERMINISTIC_SOLID, Runner, parse_
 
 VALVE = ["--set", "output.vtk=false", "--set", "fluid.outlets[0].waveform.times=[0,0.03,1]",
          "--set", "fluid.outlets[0].waveform.values=[0,-1.5,-1.5]",
-         "--set", "output.checkpoint_interval=3"]
+         "--set", "output.checkpoint_interval=20"]
 DETERMINISTIC = ["--", *DETERMINISTIC_FLUID, *DETERMINISTIC_SOLID]
 
 
@@ -43,8 +45,8 @@ def main():
                           f"time.end_time={end_time}", *VALVE, *extra, *DETERMINISTIC,
                           ranks=ranks)
 
-    runs = {"straight": run("straight", 0.012), "first": run("first", 0.006)}
-    runs["again"] = run("again", 0.012, "--restart", work / "first")
+    runs = {"straight": run("straight", 0.044), "first": run("first", 0.040)}
+    runs["again"] = run("again", 0.044, "--restart", work / "first")
     for name, result in runs.items():
         runner.expect(result.returncode == 0, f"valve {name} run succeeds",
                       result.stdout[-3000:] + result.stderr)
@@ -57,16 +59,21 @@ def main():
     runner.expect(sum(state["iqn_columns"]) > 0, "the checkpoint holds IQN-ILS columns to reuse")
     reference = read_rows(work / "straight" / "series.csv")
     again = read_rows(work / "again" / "series.csv")
-    runner.expect(len(reference) == 6 and again == reference[3:],
-                  "same ranks: steps 4..6 bit for bit as the straight run",
+    active = [int(float(row["contact_active_nodes_leaflets"])) for row in reference]
+    print(f"active contact nodes per step from step 18: {active[17:]}")
+    runner.expect(len(reference) == 22 and active[19] > 0 and min(active[20:]) > 0,
+                  f"the checkpoint (step 20) and the restarted steps are in contact "
+                  f"({active[19]} active nodes at step 20)")
+    runner.expect(len(reference) == 22 and again == reference[20:],
+                  "same ranks: steps 21..22 bit for bit as the straight run",
                   f"{len(again)} rows restarted, {len(reference)} straight\n"
-                  + "\n".join(f"{k}: {a[k]} vs {b[k]}" for a, b in zip(again, reference[3:])
+                  + "\n".join(f"{k}: {a[k]} vs {b[k]}" for a, b in zip(again, reference[20:])
                               for k in a if a[k] != b[k]))
     a = read_json(work / "straight" / "summary.json")["benchmark"]
     b = read_json(work / "again" / "summary.json")["benchmark"]
     runner.expect(a == b, "same ranks: the benchmark bit for bit", f"{a}\n{b}")
 
-    result = run("again1", 0.012, "--restart", work / "first", ranks=1)
+    result = run("again1", 0.044, "--restart", work / "first", ranks=1)
     runner.expect(result.returncode == 0, "restart on 1 rank succeeds",
                   result.stdout[-3000:] + result.stderr)
     if result.returncode == 0:
@@ -74,7 +81,7 @@ def main():
         worst = max(abs(float(last[k]) / float(expected[k]) - 1)
                     for k in ("opening_leaflets", "outlet_flow_inlet"))
         runner.expect(last["time"] == expected["time"] and worst < 1e-5,
-                      f"restart on 1 rank: step 6 agrees to 1e-5 (largest relative difference "
+                      f"restart on 1 rank: step 22 agrees to 1e-5 (largest relative difference "
                       f"{worst:.2e})")
 
     rigid = runner.source / "cases" / "dfg" / "2d1_immersed.yaml"
@@ -109,8 +116,8 @@ def main():
                       "--set", "time.end_time=0.01", "--set", "time.step=0.01", "--set",
                       "output.vtk=false", "--set", "output.checkpoint_interval=1", ranks=1)
     runner.expect(flow.returncode == 0, "a flow run writing a checkpoint succeeds", flow.stderr)
-    refused(run("bad1", 0.012, "--restart", work / "flow"), "a checkpoint of a flow run", "flow")
-    refused(run("bad2", 0.012, "--set", "solids[0].name=valve", "--set", "benchmark.solid=valve",
+    refused(run("bad1", 0.044, "--restart", work / "flow"), "a checkpoint of a flow run", "flow")
+    refused(run("bad2", 0.044, "--set", "solids[0].name=valve", "--set", "benchmark.solid=valve",
                 "--restart", work / "first"), "a checkpoint with other solids", "first")
     runner.finish()
 

@@ -546,7 +546,7 @@ class FsciProblem final : public run::Problem {
       }
       Progress progress(p.time.n_steps(), p.time.end_time, fluid_.time());
       while (fluid_.time() < p.time.end_time * (1 - 1e-12)) {
-        const double dt = std::min(p.time.time_step, p.time.end_time - fluid_.time());
+        const double dt = p.time.step_from(fluid_.time());
         CouplingReport report;
         try {
           report = step_with_retries(output, dt);

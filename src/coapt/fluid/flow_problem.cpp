@@ -202,7 +202,7 @@ class FlowProblem final : public run::Problem {
       }
       Progress progress(n_steps, p.time.end_time, model_.time());
       for (int step = first_step; step <= n_steps; ++step) {
-        const double dt = std::min(p.time.time_step, p.time.end_time - model_.time());
+        const double dt = p.time.step_from(model_.time());
         model_.begin_step(dt);
         const double time = model_.time();
         NewtonReport report;

@@ -138,6 +138,12 @@ FluidCase FluidCase::read(const config::Section& section, const config::Section&
       fluid.get<double>("c_inverse", kDefaultCInverse,
                         {"", "C_I of the stabilisation parameter τ_M (9: nodally exact 1D limits)",
                          Bounds::positive()});
+  p.fluid.tau_time_term = fluid.get<bool>(
+      "tau_time_term", true,
+      {"",
+       "include (2/Δt)² in τ_M (transient runs); false: τ_M from the convective and viscous "
+       "terms only, so that the stabilisation does not fade as Δt → 0 (time-step studies, "
+       "very small steps)"});
   auto newton = fluid.section("newton", "Newton's method per step");
   p.fluid.newton_relative_tolerance = newton.get<double>(
       "relative_tolerance", 1e-8, {"", "stop when ‖R‖ ≤ rtol ‖R₀‖", Bounds::open(0, 1)});
@@ -248,6 +254,11 @@ TimeSettings TimeSettings::read(const config::Section& root) {
 
 int TimeSettings::n_steps() const {
   return steady ? 0 : static_cast<int>(std::ceil(end_time / time_step - 1e-9));
+}
+
+double TimeSettings::step_from(double time) const {
+  const double left = end_time - time;
+  return left < time_step * (1 - 1e-9) ? left : time_step;
 }
 
 std::vector<double> values_at(const mesh::Mesh& mesh, Vec vector, int n_components, int component,
@@ -368,10 +379,12 @@ void FluidModel::describe(const std::string& title) const {
       "{:.3f}]",
       mesh_.n_global_cells, mesh_.n_global_vertices, mesh_.dim, size_of(comm_), quality_.min_shape,
       quality_.max_shape);
-  log::info("fluid: rho = {:g} kg/m^3, mu = {:g} Pa s, C_I = {:g}, {}, {} form of the viscous term",
-            parameters_.fluid.density, parameters_.fluid.viscosity, parameters_.fluid.c_inverse,
-            parameters_.fluid.convection ? "Navier-Stokes" : "Stokes",
-            parameters_.fluid.viscous_form == ViscousForm::stress ? "stress" : "Laplace");
+  log::info(
+      "fluid: rho = {:g} kg/m^3, mu = {:g} Pa s, C_I = {:g}{}, {}, {} form of the viscous term",
+      parameters_.fluid.density, parameters_.fluid.viscosity, parameters_.fluid.c_inverse,
+      parameters_.fluid.tau_time_term ? "" : " (tau_M without the time term)",
+      parameters_.fluid.convection ? "Navier-Stokes" : "Stokes",
+      parameters_.fluid.viscous_form == ViscousForm::stress ? "stress" : "Laplace");
 }
 
 int FluidModel::boundary_tag(const std::string& name, const std::string& key) const {

@@ -113,6 +113,10 @@ struct TimeSettings {
   static TimeSettings read(const config::Section& root);
   /// Number of steps to reach end_time (the last one may be shorter).
   int n_steps() const;
+  /// The step from `time`: time_step, or what is left to end_time when that is shorter by
+  /// more than round-off. A run that ends at a multiple of the step thus takes the same steps
+  /// as a longer run, so that a restart from its last checkpoint continues bit for bit.
+  double step_from(double time) const;
 };
 
 /// Values of component `component` of a vertex vector with `n_components` per vertex at

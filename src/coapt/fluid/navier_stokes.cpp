@@ -20,14 +20,14 @@ namespace {
 /// 3D: GMRES with a Schur-complement fieldsplit: velocity split "u", pressure split "p"
 /// (configure_preconditioner), upper-triangular factorisation, one BoomerAMG V-cycle on the
 /// velocity block and one on the pressure preconditioner S_p of update_schur_preconditioner.
-/// The work per iteration is linear in the mesh and the iterations per Newton step grew by
-/// less than 1.1x per refinement on a 3D channel; a Newton step needs only an inexact solve
-/// (1e-6 keeps the Newton residual histories of the direct solver).
-/// 2D: GMRES + LU (MUMPS, any number of ranks), 1 iteration per Newton step. The 2D meshes
-/// are small enough for it, and the fieldsplit took 55–105 iterations per step on DFG 2D-1
-/// (the convection-dominated flow there is where the S_p above is weakest).
-/// docs/verification/fluid.md, "Linear solver", has the measurements; -fluid_pc_type
-/// fieldsplit or lu switches in either dimension.
+/// GMRES restarts after 100 iterations. The work per iteration is linear in the mesh and the
+/// iterations per Newton step grew by 1.3x or less per refinement on a 3D channel and 1.6x on
+/// DFG 3D-1Z (configure_preconditioner, update_schur_preconditioner); a Newton step needs only an
+/// inexact solve (1e-6 keeps the Newton residual histories of the direct solver). 2D: GMRES + LU
+/// (MUMPS, any number of ranks), 1 iteration per Newton step. The 2D meshes are small enough for
+/// it, and the fieldsplit took 55–105 iterations per step on DFG 2D-1 (the convection-dominated
+/// flow there is where the S_p above is weakest). docs/verification/fluid.md, "Linear solver", has
+/// the measurements; -fluid_pc_type fieldsplit or lu switches in either dimension.
 fem::LinearSolverDefaults solver_defaults(int dim) {
   fem::LinearSolverDefaults defaults;
   defaults.ksp_type = "gmres";
@@ -139,8 +139,14 @@ void NavierStokes::configure_preconditioner() {
   COAPT_PETSC_CHECK(
       PetscOptionsHasName(nullptr, nullptr, "-fluid_pc_fieldsplit_schur_precondition", &given));
   user_schur_ = !given;
+  PetscBool restart_given = PETSC_FALSE;
+  COAPT_PETSC_CHECK(
+      PetscOptionsHasName(nullptr, nullptr, "-fluid_ksp_gmres_restart", &restart_given));
   // The user's options override the set-up above (Schur factorisation, sub-solvers, ...).
   COAPT_PETSC_CHECK(KSPSetFromOptions(solver_.ksp()));
+  // GMRES(30) restarted 6–10 times per solve on DFG 3D-1Z, taking 3–4 times the iterations
+  // of GMRES(100) there (a no-op for other Krylov methods).
+  if (!restart_given) COAPT_PETSC_CHECK(KSPGMRESSetRestart(solver_.ksp(), 100));
   PCCompositeType type = PC_COMPOSITE_SCHUR;
   COAPT_PETSC_CHECK(PCFieldSplitGetType(pc, &type));
   user_schur_ = user_schur_ && type == PC_COMPOSITE_SCHUR;
@@ -151,8 +157,12 @@ void NavierStokes::update_schur_preconditioner(const TimeLevel& time) {
   // where the velocity block is dominated by the mass ρα₀/Δt, but misses the smooth pressure
   // modes of the viscous regime, where S ≈ M_p/μ: iterations grew by about 1.6 per refinement
   // on a steady 3D channel. Adding the lumped pressure mass with the weight c/μ_eff,
-  // μ_eff = μ + ρ h_K² α₀/Δt (the two terms of the Cahouet–Chabard preconditioner
-  // S⁻¹ ≈ μ M_p⁻¹ + (ρ/Δt) L_p⁻¹, lumped element by element), restores both limits.
+  // μ_eff = μ + ρ h_K² α₀/Δt + ρ |ū_K| h_K, restores the limits: the first two terms are those
+  // of the Cahouet–Chabard preconditioner S⁻¹ ≈ μ M_p⁻¹ + (ρ/Δt) L_p⁻¹, lumped element by
+  // element; the third is the convective counterpart, as an element Péclet number enlarges
+  // the viscosity seen by the pressure (without it, DFG 3D-1Z at Re = 20 took 176–228 GMRES
+  // iterations per Newton step: the mass term 1/μ outweighed the selfp part where the flow
+  // convects).
   Mat jacobian = matrix_.mat();
   const int dim = mesh_.dim, n = dim + 1;
   OwnedVec diagonal;
@@ -179,10 +189,13 @@ void NavierStokes::update_schur_preconditioner(const TimeLevel& time) {
       MatAXPY(schur_preconditioner_, 1.0, pressure_pressure, UNKNOWN_NONZERO_PATTERN));
   // Lumped pressure mass / μ_eff over the owned cells (each cell once).
   const double mass_rate = time.time_step > 0 ? time.alpha[0] / time.time_step : 0.0;
-  // The weight of the mass term (-fluid_schur_mass_scale): 0.3 gave the flattest iteration
-  // counts on the 3D channel (1: more iterations, the velocity AMG's error dominating; 0:
-  // selfp alone, growing with the mesh).
-  PetscReal mass_scale = 0.3;
+  // The weight c of the mass term (-fluid_schur_mass_scale). With the convective part of
+  // μ_eff, 0.1 took the fewest GMRES iterations per Newton step on both the viscous box
+  // channel (15, 20, 26 on three levels) and DFG 3D-1Z (34, 53 on levels 0–1); 0.3 took 20,
+  // 23, 28 and 43, 70; 1 and 3 many more; 0 (selfp alone) 25 and 45 on 3D-1Z, growing fastest.
+  // An exact solve of the velocity block or of S_p does not lower these counts: they are the
+  // quality of S_p as an approximation of S (docs/verification/fluid.md, "Linear solver").
+  PetscReal mass_scale = 0.1;
   COAPT_PETSC_CHECK(
       PetscOptionsGetReal(nullptr, "fluid_", "-schur_mass_scale", &mass_scale, nullptr));
   OwnedVec mass;
@@ -190,9 +203,15 @@ void NavierStokes::update_schur_preconditioner(const TimeLevel& time) {
   COAPT_PETSC_CHECK(VecSet(mass, 0.0));
   std::vector<PetscInt> rows(static_cast<std::size_t>(n));
   std::vector<PetscScalar> values(static_cast<std::size_t>(n));
+  fem::update_ghosts(state_);
+  const fem::LocalValues state(state_);
   for (int c = 0; c < mesh_.n_owned_cells; ++c) {
     const auto cell = mesh_.cell(c);
     const auto p0 = mesh_.point(cell[0]);
+    double mean[3] = {};  // ū_K, the element-mean velocity of the current iterate
+    for (int a = 0; a < n; ++a)
+      for (int i = 0; i < dim; ++i) mean[i] += state[static_cast<std::size_t>(cell[a]) * n + i] / n;
+    const double speed = std::sqrt(mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2]);
     double edges[3][3] = {};
     for (int a = 0; a < dim; ++a)
       for (int i = 0; i < dim; ++i) edges[a][i] = mesh_.point(cell[a + 1])[i] - p0[i];
@@ -203,8 +222,9 @@ void NavierStokes::update_schur_preconditioner(const TimeLevel& time) {
                        edges[0][2] * (edges[1][0] * edges[2][1] - edges[1][1] * edges[2][0]);
     const double measure = std::abs(determinant) / (dim == 2 ? 2.0 : 6.0);
     const double size = std::pow(std::abs(determinant), 1.0 / dim);  // h_K
-    const double viscosity =
-        parameters_.viscosity + parameters_.density * size * size * mass_rate;  // μ_eff
+    const double convection = parameters_.convection ? parameters_.density * speed * size : 0.0;
+    const double viscosity = parameters_.viscosity + parameters_.density * size * size * mass_rate +
+                             convection;  // μ_eff
     for (int a = 0; a < n; ++a) {
       rows[a] = mesh_.global_vertex[cell[a]] * n + dim;
       values[a] = mass_scale * measure / n / viscosity;
@@ -452,7 +472,8 @@ void NavierStokes::assemble(const TimeLevel& time, bool with_matrix) {
         data.history[a][i] = transient ? history / time.time_step : 0.0;
       }
     }
-    set_stabilisation<Dim>(data, mean, time.time_step, parameters_.c_inverse);
+    set_stabilisation<Dim>(data, mean, parameters_.tau_time_term ? time.time_step : 0.0,
+                           parameters_.c_inverse);
   };
   // The backflow facets of local cell c, unpacked from set_outlets' layout.
   auto backflow_facets = [&](int c, auto&& use) {

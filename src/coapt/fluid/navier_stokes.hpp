@@ -33,8 +33,10 @@ struct FluidParameters {
   bool convection = true;                           ///< false: Stokes
   ViscousForm viscous_form = ViscousForm::laplace;  ///< the viscous term (kernels.hpp)
   double c_inverse = 9.0;                           ///< C_I of τ_M (kernels.hpp)
-  double newton_relative_tolerance = 1e-8;          ///< ‖R‖ ≤ rtol ‖R₀‖ ...
-  double newton_absolute_tolerance = 1e-10;         ///< ... or ‖R‖ ≤ atol
+  /// τ_M includes (2/Δt)² (false: only the convective and viscous terms, independent of Δt)
+  bool tau_time_term = true;
+  double newton_relative_tolerance = 1e-8;   ///< ‖R‖ ≤ rtol ‖R₀‖ ...
+  double newton_absolute_tolerance = 1e-10;  ///< ... or ‖R‖ ≤ atol
   int newton_max_iterations = 25;
   /// Halvings of a Newton correction that raises ‖R‖ (backtracking while ‖R‖ stays above
   /// the last iterate's; the trial with the smallest ‖R‖ is kept); 0: full corrections.
