@@ -203,8 +203,7 @@ void NavierStokes::update_schur_preconditioner(const TimeLevel& time) {
   COAPT_PETSC_CHECK(VecSet(mass, 0.0));
   std::vector<PetscInt> rows(static_cast<std::size_t>(n));
   std::vector<PetscScalar> values(static_cast<std::size_t>(n));
-  fem::update_ghosts(state_);
-  const fem::LocalValues state(state_);
+  const fem::LocalValues state(state_);  // its ghosts are current: assemble() updated them
   for (int c = 0; c < mesh_.n_owned_cells; ++c) {
     const auto cell = mesh_.cell(c);
     const auto p0 = mesh_.point(cell[0]);
