@@ -151,7 +151,10 @@ void ContactConstraints::update(Vec u, Vec residual) {
                               : gap <= tolerance;
       pair.pressure[j] = pressure;
       pair.active[j] = active;
-      status.changes += active != was_active ? 1 : 0;
+      if (active != was_active && ++status.changes <= 4)
+        status.changed_nodes += fmt::format("{}{}:{} {} (p {:.3e} Pa, g {:.3e} m)",
+                                            status.changed_nodes.empty() ? "" : ", ", p, j,
+                                            active ? "in" : "out", pressure, gap);
       status.max_penetration = std::max(status.max_penetration, -gap);
       status.max_complementarity = std::max(status.max_complementarity, std::abs(pressure * gap));
       if (active) {

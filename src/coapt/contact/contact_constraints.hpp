@@ -72,6 +72,8 @@ struct ContactStatus {
   std::array<double, 3> force_vector{};
   double complementarity_constant = 0.0;  ///< c in use [Pa/m] (0: not yet known)
   double gap_tolerance = 0.0;             ///< [m]
+  /// The first nodes that changed at the update: "pair:node in|out (p, g)", for the log.
+  std::string changed_nodes;
 };
 
 /// One pair's surfaces and state, for output and benchmarks (the same on every rank).

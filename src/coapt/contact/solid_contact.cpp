@@ -271,8 +271,8 @@ bool ContactHook::accept(Vec u) {
   if (status.changes == 0) return true;
   ++changing_iterations_;
   changed_nodes_ += status.changes;
-  log::debug("contact: {} node(s) changed the active set ({} active)", status.changes,
-             status.active);
+  log::debug("contact: {} node(s) changed the active set ({} active): {}", status.changes,
+             status.active, status.changed_nodes);
   if (changing_iterations_ > parameters_.max_active_set_changes)
     throw ConvergenceError(fmt::format(
         "contact: the active set still changes after {} Newton iterations ({} of {} nodes "

@@ -194,7 +194,8 @@ Parameters read(const config::Section& root) {
       "freeze_constrained_after", 0,
       {"",
        "from this coupling iteration of a step on, keep each solid's set of constrained fluid "
-       "nodes (the covered-node rule makes the iteration map discontinuous; 0: never)",
+       "nodes (the covered-node rule makes the iteration map discontinuous; 1: the set the "
+       "step's starting configuration covers; 0: never)",
        Bounds::closed(0, 10000)});
   c.retries = iteration.get<int>(
       "retries", 2,
@@ -903,7 +904,17 @@ class FsciProblem final : public run::Problem {
     for (auto& solid : solids_)
       if (solid->model) COAPT_PETSC_CHECK(VecCopy(solid->applied, solid->applied_start));
     if (quasi_newton_) quasi_newton_->begin_step();
-    for (auto& solid : solids_) solid->constraint->set_frozen(false);
+    for (auto& solid : solids_) {
+      solid->constraint->set_frozen(false);
+      if (c.freeze_after == 1 && solid->model) {
+        // Frozen from the first iteration: the set the committed configuration covers (the
+        // 0th iterate), so that it follows the solid from step to step.
+        ScopedTimer timer(output.timers(), "transfer");
+        const auto coordinates = solid->model->current_coordinates();
+        std::copy(coordinates.begin(), coordinates.end(), solid->mesh.coordinates.begin());
+        solid->constraint->update_solid(solid->mesh);
+      }
+    }
     double omega = relaxation, first_norm = 0;
     bool fell_back = false;  // the last update was the relaxed fallback of a failed solid solve
     for (int iteration = 1; iteration <= (deformable_ ? c.max_iterations : 1); ++iteration) {

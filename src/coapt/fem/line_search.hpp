@@ -6,7 +6,20 @@
 #include <cmath>
 #include <limits>
 
+#include "coapt/core/config.hpp"
+
 namespace coapt::fem {
+
+/// The `line_search` key of a `newton:` section (the solid's and the fluid's): the number of
+/// halvings, 0 for full steps.
+inline int read_line_search(const config::Section& newton) {
+  return newton.get<int>(
+      "line_search", 0,
+      {"",
+       "halvings of a Newton update that raises the residual norm (backtracking while it stays "
+       "above the last iterate's; the trial with the smallest norm is kept); 0: full updates",
+       config::Bounds::closed(0, 20)});
+}
 
 /// What backtrack() kept: the residual norm there and the step length.
 struct Backtracking {

@@ -14,6 +14,7 @@
 #include "coapt/core/error.hpp"
 #include "coapt/core/log.hpp"
 #include "coapt/fem/assembly.hpp"
+#include "coapt/fem/line_search.hpp"
 #include "coapt/fem/p1.hpp"
 #include "coapt/fluid/kernels.hpp"
 
@@ -151,12 +152,7 @@ FluidCase FluidCase::read(const config::Section& section, const config::Section&
       "absolute_tolerance", 1e-10, {"", "or when ‖R‖ ≤ atol", Bounds::non_negative()});
   p.fluid.newton_max_iterations =
       newton.get<int>("max_iterations", 25, {"", "Newton iterations", Bounds::closed(1, 1000)});
-  p.fluid.newton_line_search = newton.get<int>(
-      "line_search", 0,
-      {"",
-       "halvings of a correction that raises ‖R‖ (backtracking while ‖R‖ stays above the last "
-       "iterate's; the trial with the smallest ‖R‖ is kept); 0: full corrections",
-       Bounds::closed(0, 20)});
+  p.fluid.newton_line_search = fem::read_line_search(newton);
 
   for (const auto& entry : section.sections("boundary", "boundary conditions, in order")) {
     BoundaryCondition bc;

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "coapt/core/error.hpp"
+#include "coapt/fem/line_search.hpp"
 
 namespace coapt::solid {
 
@@ -193,12 +194,7 @@ SolidParameters SolidParameters::read(const config::Section& root) {
       {"", "or when |du| <= dtol |u| (round-off floor of R)", Bounds::closed(0.0, 1e-3)});
   p.newton.max_iterations = newton.get<int>(
       "max_iterations", 25, {"", "iterations per load step", Bounds::closed(1, 1000)});
-  p.newton.line_search = newton.get<int>(
-      "line_search", 0,
-      {"",
-       "halvings of an update that raises |R| (backtracking while |R| stays above the last "
-       "iterate's; the trial with the smallest |R| is kept); 0: full steps",
-       Bounds::closed(0, 20)});
+  p.newton.line_search = fem::read_line_search(newton);
   p.newton.extrapolate =
       newton.choice("predictor", "previous", {"previous", "extrapolate"},
                     {"",
