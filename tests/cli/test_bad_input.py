@@ -48,6 +48,10 @@ def main():
                        ["run", cases / "turek_hron" / "fsi1.yaml", "--output", work / "o3",
                         "--set", "solids[0].output.checkpoint_interval=5"],
                        ["solids[0].output.checkpoint_interval", "output.checkpoint_interval"])
+    expect_input_error("an iteration density in a steady coupled case",
+                       ["check", cases / "turek_hron" / "fsi1.yaml",
+                        "--set", "coupling.iteration.iteration_density=1000"],
+                       ["coupling.iteration.iteration_density", "transient"])
     unknown_problem = write(work / "unknown_problem.yaml", "problem: poison\n")
     expect_input_error("unknown problem", ["check", unknown_problem], ["unknown_problem.yaml:1", "problem", "poison"])
 

@@ -1,8 +1,10 @@
 // SolidModel as the coupled problems use it, on 1, 2 and 3 ranks: the extra nodal force
 // enters the residual like a load, a Newmark step repeated from the committed state (a
 // coupling iteration) gives the same trial state, a body whose inertia density is offset
-// to zero (an immersed solid as dense as the fluid) steps quasi-statically, and a driver's
-// options (SolidModelOptions) make a case without time keys dynamic and refine its mesh.
+// to zero (an immersed solid as dense as the fluid) steps quasi-statically, the iteration
+// inertia (set_iteration_density) cancels at the fixed point of the iteration that loads the
+// solid with its iteration_force(), and a driver's options (SolidModelOptions) make a case
+// without time keys dynamic and refine its mesh.
 
 #include <gtest/gtest.h>
 #include <petscvec.h>
@@ -145,6 +147,58 @@ TEST(SolidModel, ZeroInertiaDensityStepsQuasiStatically) {
   EXPECT_LT(max_difference(reference.displacement(), solid.displacement()), 1e-10 * scale);
 
   EXPECT_THROW(solid.set_density_offset(1001), coapt::InputError);
+}
+
+TEST(SolidModel, IterationInertiaCancelsAtTheFixedPointOfItsIteration) {
+  // The coupling's use (fsci_problem.cpp): the load g is iterated as g ← f + iteration_force()
+  // (here f = 0, gravity being the case's own load) and the solid committed with g less the
+  // last iteration force. Two steps of each scheme; the density 0.1 kg/m³ makes the iteration
+  // contract quickly on this strip (the term's effect does not depend on its size).
+  for (const bool stabilized : {false, true}) {
+    SCOPED_TRACE(stabilized ? "contact_stabilized_newmark" : "newmark");
+    Output output(stabilized ? "iteration_inertia_csn" : "iteration_inertia");
+    const std::string keys =
+        "gravity: [0, -0.5]\ntime: {scheme: newmark, step: 0.01, end_time: 1, "
+        "initial_velocity: [0, 0.05]}\n";
+    auto document = Document::from_string(strip_case(keys), "dynamic.yaml");
+    SolidModel plain(document.root(), kWorld), iterated(document.root(), kWorld);
+    for (auto* model : {&plain, &iterated}) {
+      model->set_density_offset(900);
+      model->set_contact_stabilized(stabilized);
+    }
+    iterated.set_iteration_density(0.1);
+    plain.initialize_dynamics(output.output);
+    iterated.initialize_dynamics(output.output);
+    OwnedVec load = coapt::fem::create_vertex_vector(iterated.mesh(), 2);
+    OwnedVec force = coapt::fem::create_vertex_vector(iterated.mesh(), 2);
+    VecSet(load, 0.0);
+    iterated.set_external_force(load);
+    for (int n = 1; n <= 2; ++n) {
+      const double time = 0.01 * n;
+      plain.step(time, 0.01, output.output);
+      const double scale = max_norm(plain.displacement());
+      double change = 0;
+      int iterations = 0;
+      for (iterations = 1; iterations <= 100; ++iterations) {
+        iterated.step(time, 0.01, output.output);
+        iterated.iteration_force(force);
+        change = max_difference(force, load);
+        VecCopy(force, load);
+        if (iterations == 1 && n == 1) {
+          // the first iterate is not the plain step: the term acts
+          EXPECT_GT(max_difference(plain.displacement(), iterated.displacement()), 1e-6 * scale);
+        }
+        if (change < 1e-13) break;
+      }
+      EXPECT_LT(change, 1e-13) << iterations << " iterations";
+      EXPECT_LT(max_difference(plain.displacement(), iterated.displacement()), 1e-10 * scale);
+      EXPECT_LT(max_difference(plain.velocity(), iterated.velocity()),
+                1e-8 * max_norm(plain.velocity()));
+      VecAXPY(load, -1.0, force);  // committed with g − iteration_force = 0
+      plain.commit();
+      iterated.commit();
+    }
+  }
 }
 
 TEST(SolidModel, DriverOptionsMakeItDynamicAndRefineItsMesh) {

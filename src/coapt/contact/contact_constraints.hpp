@@ -114,8 +114,6 @@ class ContactConstraints {
   /// against a held master, a small quadratic program between two deformable bodies (see the
   /// definition). Returns the number of slave nodes whose constraint is active. Collective.
   int project_predictor(Vec u, Vec increment, Vec lumped_mass);
-  /// Forgets the previous active set's change count (a new step). Not collective.
-  void begin_step() { settled_updates_ = 0; }
 
   /// Pair p's active set into `marker` (a vector with the layout given at construction): 1 in
   /// every component of its active slave nodes, 0 elsewhere (owned entries; for a
@@ -173,7 +171,6 @@ class ContactConstraints {
   std::vector<std::unique_ptr<SurfaceGather>> slave_gathers_, master_gathers_;
   std::vector<double> reference_sizes_;  ///< mean slave facet size per pair [m]
   double complementarity_constant_ = 0.0;
-  int settled_updates_ = 0;
   ContactStatus status_;
   OwnedMat row_operator_;  ///< P
   OwnedMat gap_rows_;      ///< G

@@ -246,7 +246,6 @@ void ContactHook::read_checkpoint(const run::CheckpointReader& reader, const std
 
 void ContactHook::begin_step(Vec u) {
   (void)u;
-  constraints_.begin_step();
   changing_iterations_ = 0;
   changed_nodes_ = 0;
 }

@@ -52,6 +52,7 @@ struct CouplingSettings {
   double filter = 1e-8;  ///< iqn_ils: QR filter
   int retries = 2;       ///< stronger relaxation, then (transient) halved steps
   int freeze_after = 0;  ///< keep the constrained sets from this iteration of a step on (0: never)
+  double iteration_density = 0;  ///< transient: the solids' iteration inertia [kg/m³] (0: none)
 };
 
 /// `benchmark:` of an immersed body in a channel (the DFG cylinder).
@@ -190,6 +191,14 @@ Parameters read(const config::Section& root) {
       "filter", 1e-8,
       {"", "iqn_ils: drop a column whose part orthogonal to the newer ones is below this fraction",
        Bounds{0.0, 1.0, false, false}});
+  c.iteration_density = iteration.get<double>(
+      "iteration_density", 0.0,
+      {"kg/m^3",
+       "transient: an artificial density added to the deformable solids' inertia during a "
+       "step's coupling iterations and cancelled at convergence (the solution does not depend "
+       "on it): damps the added-mass instability of the iteration when the solids carry little "
+       "density of their own (rho_s - rho_f); 0: none",
+       Bounds::non_negative()});
   c.freeze_after = iteration.get<int>(
       "freeze_constrained_after", 0,
       {"",
@@ -202,6 +211,9 @@ Parameters read(const config::Section& root) {
       {"", "failed step: retry with half the relaxation, then (transient) with half the step",
        Bounds::closed(0, 10)});
   p.time = fluid::TimeSettings::read(root);
+  if (p.time.steady && c.iteration_density > 0)
+    iteration.fail("iteration_density",
+                   "acts on the inertia of transient runs only, and time.steady is true");
 
   auto benchmark = root.section("benchmark", "benchmark quantities written to summary.json");
   auto& b = p.benchmark;
@@ -327,6 +339,17 @@ struct Solid {
   // and the last residual f − f_applied (Aitken)
   OwnedVec applied, applied_start, residual, previous_residual;
   OwnedVec applied_previous;  ///< iqn_ils: the applied force of the last iterate
+  /// deformable: the load the last iterate asks for, force + the solid's iteration inertia
+  /// (the force alone without coupling.iteration.iteration_density), and that inertia
+  OwnedVec target, iteration_force;
+
+  /// Deformable: the model's current configuration into the mesh and the transfer (the
+  /// constrained set is recomputed unless frozen). Collective.
+  void update_configuration() {
+    const auto coordinates = model->current_coordinates();
+    std::copy(coordinates.begin(), coordinates.end(), mesh.coordinates.begin());
+    constraint->update_solid(mesh);
+  }
 };
 
 /// Adds the contact hook's time over its own lifetime (one solid solve, also one that throws)
@@ -380,6 +403,7 @@ class FsciProblem final : public run::Problem {
         if (transient) {  // the fluid mesh carries ρ_f over the overlap
           solid->model->set_density_offset(parameters_.fluid.fluid.density);
           solid->model->set_contact_stabilized(entry.contact_stabilized);
+          solid->model->set_iteration_density(parameters_.coupling.iteration_density);
         }
         if (entry.contact.enabled()) {
           solid->contact = std::make_unique<contact::ContactHook>(entry.contact, *solid->model);
@@ -508,8 +532,9 @@ class FsciProblem final : public run::Problem {
             std::make_unique<ImmersedConstraint>(fluid_.mesh(), solid->mesh, parameters_.transfer);
         solid->force = solid->constraint->create_solid_vector();
         if (!solid->model) continue;
-        for (auto* v : {&solid->applied, &solid->applied_start, &solid->residual,
-                        &solid->previous_residual, &solid->applied_previous}) {
+        for (auto* v :
+             {&solid->applied, &solid->applied_start, &solid->residual, &solid->previous_residual,
+              &solid->applied_previous, &solid->target, &solid->iteration_force}) {
           *v = solid->constraint->create_solid_vector();
           COAPT_PETSC_CHECK(VecSet(*v, 0.0));
         }
@@ -910,9 +935,7 @@ class FsciProblem final : public run::Problem {
         // Frozen from the first iteration: the set the committed configuration covers (the
         // 0th iterate), so that it follows the solid from step to step.
         ScopedTimer timer(output.timers(), "transfer");
-        const auto coordinates = solid->model->current_coordinates();
-        std::copy(coordinates.begin(), coordinates.end(), solid->mesh.coordinates.begin());
-        solid->constraint->update_solid(solid->mesh);
+        solid->update_configuration();
       }
     }
     double omega = relaxation, first_norm = 0;
@@ -949,9 +972,7 @@ class FsciProblem final : public run::Problem {
           }
         }
         ScopedTimer timer(output.timers(), "transfer");
-        const auto coordinates = solid->model->current_coordinates();
-        std::copy(coordinates.begin(), coordinates.end(), solid->mesh.coordinates.begin());
-        solid->constraint->update_solid(solid->mesh);
+        solid->update_configuration();
       }
       if (solid_failed) {
         quasi_newton_->reset();
@@ -985,7 +1006,12 @@ class FsciProblem final : public run::Problem {
       double norm2 = 0, force2 = 0, dot = 0, difference2 = 0;
       for (auto& solid : solids_) {
         if (!solid->model) continue;
-        COAPT_PETSC_CHECK(VecWAXPY(solid->residual, -1.0, solid->applied, solid->force));
+        COAPT_PETSC_CHECK(VecCopy(solid->force, solid->target));
+        if (c.iteration_density > 0 && !steady) {
+          solid->model->iteration_force(solid->iteration_force);
+          COAPT_PETSC_CHECK(VecAXPY(solid->target, 1.0, solid->iteration_force));
+        }
+        COAPT_PETSC_CHECK(VecWAXPY(solid->residual, -1.0, solid->applied, solid->target));
         double n = 0, f = 0;
         COAPT_PETSC_CHECK(VecNorm(solid->residual, NORM_2, &n));
         COAPT_PETSC_CHECK(VecNorm(solid->force, NORM_2, &f));
@@ -1011,6 +1037,12 @@ class FsciProblem final : public run::Problem {
         omega = std::clamp(-omega * dot / difference2, 0.01, 1.0);
       report.relaxation.push_back(quasi_newton_ ? std::numeric_limits<double>::quiet_NaN() : omega);
       if (norm <= c.absolute_tolerance || norm <= c.relative_tolerance * first_norm) {
+        // The solids are committed with the load their last state balances, f_applied less
+        // the iteration inertia: the force the next step starts from.
+        if (c.iteration_density > 0 && !steady)
+          for (auto& solid : solids_)
+            if (solid->model)
+              COAPT_PETSC_CHECK(VecAXPY(solid->applied, -1.0, solid->iteration_force));
         result.converged = true;
         break;
       }
@@ -1046,7 +1078,7 @@ class FsciProblem final : public run::Problem {
     for (auto& solid : solids_)
       if (solid->model) {
         append(solid->applied, x);
-        append(solid->force, x_tilde);
+        append(solid->target, x_tilde);
       }
     std::vector<double> next(x.size());
     last_columns_ = quasi_newton_->next(x, x_tilde, omega, next);

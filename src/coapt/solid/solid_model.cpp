@@ -221,6 +221,20 @@ class SolidModelImpl {
     parameters_.time.contact_stabilized = contact_stabilized;
   }
 
+  void set_iteration_density(double density) {
+    if (!(density >= 0))
+      throw InternalError("solid: set_iteration_density() with a negative density");
+    iteration_density_ = density;
+    iteration_mass_.reset();
+  }
+
+  void iteration_force(Vec out) const {
+    if (iteration_force_)
+      COAPT_PETSC_CHECK(VecCopy(iteration_force_, out));
+    else
+      COAPT_PETSC_CHECK(VecSet(out, 0.0));
+  }
+
   void set_density_offset(double offset) {
     for (const auto& body : parameters_.bodies)
       if (body.density - offset < 0)
@@ -435,9 +449,11 @@ class SolidModelImpl {
     fem::update_ghosts(u_);
     const auto residual_norm = [&] {
       update_acceleration(scheme);
+      if (iteration_density_ > 0) add_iteration_inertia();
       ScopedTimer timer(output.timers(), "assemble");
       return assemble_residual(u_.get(), 1.0, inertia_.get());
     };
+    if (iteration_density_ > 0) prepare_iteration_inertia(scheme);
     StepReport report;
     if (hook_) hook_->begin_step(u_.get());
     double norm = residual_norm();
@@ -1370,7 +1386,58 @@ class SolidModelImpl {
       std::copy(K.data(), K.data() + K.size(), element);
       add_pressure<Dim>(c, displacement, pressure_factor_, true, element);
       if (mass_factor != 0) add_element_mass(c, mass_factor, element);
+      if (mass_factor != 0 && iteration_density_ > 0)
+        add_lumped_mass<Dim>(c, mass_factor * iteration_density_, element);
     });
+  }
+
+  /// Adds factor |c|/(Dim+1) δ_ij to the diagonal of cell c's element matrix (node-major).
+  template <int Dim>
+  void add_lumped_mass(int c, double factor, double* element) const {
+    constexpr int n = (Dim + 1) * Dim;
+    const auto mass = fem::element_mass<Dim>(geometry<Dim>(c));
+    for (int a = 0; a <= Dim; ++a)
+      for (int b = 0; b <= Dim; ++b)
+        for (int i = 0; i < Dim; ++i)
+          element[(a * Dim + i) * n + a * Dim + i] += factor * mass(a, b);
+  }
+
+  /// The iteration inertia of a step (set_iteration_density): the lumped mass m_a of the
+  /// iteration density (once), the reference u_p = uₙ + Δt vₙ and the factor 4/Δt². (Not the
+  /// Newmark predictor with Δt²/2 aₙ: the acceleration of a solid with little inertia density
+  /// is noisy, and on FSI3 that predictor starts each step 50–200 times further off.)
+  void prepare_iteration_inertia(const Newmark& scheme) {
+    if (!iteration_mass_) {
+      fem::P1Matrix lumped(mesh_, dim_);
+      lumped.assemble([&](int c, double* element) {
+        const int n = (dim_ + 1) * dim_;
+        std::fill(element, element + n * n, 0.0);
+        if (dim_ == 2)
+          add_lumped_mass<2>(c, iteration_density_, element);
+        else
+          add_lumped_mass<3>(c, iteration_density_, element);
+      });
+      COAPT_PETSC_CHECK(VecDuplicate(u_, iteration_mass_.out()));
+      COAPT_PETSC_CHECK(MatGetDiagonal(lumped.mat(), iteration_mass_));
+      COAPT_PETSC_CHECK(VecDuplicate(u_, iteration_reference_.out()));
+      COAPT_PETSC_CHECK(VecDuplicate(u_, iteration_force_.out()));
+    }
+    {
+      WriteArray up(iteration_reference_);
+      ReadArray un(u_committed_), vn(v_committed_);
+      for_each_owned(iteration_reference_,
+                     [&](PetscInt k) { up[k] = un[k] + scheme.step * vn[k]; });
+    }
+    iteration_factor_ = scheme.mass_factor();
+  }
+
+  /// iteration_force_ = 4/Δt² m_a (u − u_p) (0 on Dirichlet dofs), added to inertia_.
+  void add_iteration_inertia() {
+    COAPT_PETSC_CHECK(VecWAXPY(iteration_force_, -1.0, iteration_reference_, u_));
+    COAPT_PETSC_CHECK(VecPointwiseMult(iteration_force_, iteration_force_, iteration_mass_));
+    COAPT_PETSC_CHECK(VecScale(iteration_force_, iteration_factor_));
+    zero_dirichlet(iteration_force_);
+    COAPT_PETSC_CHECK(VecAXPY(inertia_, 1.0, iteration_force_));
   }
 
   /// Adds scale (ρ_body − ρ_offset) M_ab δ_ij (consistent P1 mass, node-major) of cell c.
@@ -1630,6 +1697,10 @@ class SolidModelImpl {
   Vec extra_force_ = nullptr;   ///< not owned
   NewtonHook* hook_ = nullptr;  ///< not owned
   double density_offset_ = 0;
+  // set_iteration_density: the density, its lumped mass m_a, u_p of the step, 4/Δt², and
+  // 4/Δt² m_a (u − u_p) of the last residual
+  double iteration_density_ = 0, iteration_factor_ = 0;
+  OwnedVec iteration_mass_, iteration_reference_, iteration_force_;
 };
 
 }  // namespace detail
@@ -1676,6 +1747,12 @@ void SolidModel::set_external_force(Vec force) {
 }
 void SolidModel::set_hook(NewtonHook* hook) {
   impl_->set_hook(hook);
+}
+void SolidModel::set_iteration_density(double density) {
+  impl_->set_iteration_density(density);
+}
+void SolidModel::iteration_force(Vec out) const {
+  impl_->iteration_force(out);
 }
 void SolidModel::set_density_offset(double offset) {
   impl_->set_density_offset(offset);

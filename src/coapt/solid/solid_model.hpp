@@ -157,6 +157,16 @@ class SolidModel {
   /// Inertia uses the density ρ_body − offset [kg/m³] (≥ 0 for every body, else InputError).
   /// Call before initialize_dynamics().
   void set_density_offset(double offset);
+  /// Iteration inertia for a driver that repeats step() (the coupling iterations): step()
+  /// solves with the extra term 4/Δt² m_a (u − u_p), m_a the row-lumped mass of `density`
+  /// over the whole solid and u_p = uₙ + Δt vₙ, fixed within the step. The term is
+  /// an artificial mass against the change of the load from one iteration to the next; the
+  /// driver loads the solid with f + iteration_force() of the last iterate, so that at its
+  /// fixed point the term cancels (0: none, the default).
+  void set_iteration_density(double density);
+  /// 4/Δt² m_a (u − u_p) of the trial state after step() (0 on Dirichlet dofs; 0 without an
+  /// iteration density). `out`: a vertex vector of this mesh. Collective.
+  void iteration_force(Vec out) const;
   /// The time scheme of step(): plain Newmark (false) or contact-stabilized Newmark (true),
   /// for drivers that choose it themselves (the immersed coupling). Call before
   /// initialize_dynamics().
