@@ -40,7 +40,9 @@ ContactParameters ContactParameters::read(const config::Section& root) {
   p.coverage_threshold =
       section.get<double>("coverage_threshold", 1.0 - 1e-8,
                           {"",
-                           "covered fraction of a slave node's support needed to constrain it",
+                           "covered fraction of a slave node's support needed to constrain it "
+                           "(1 - 1e-8: the whole support; lower: contact follows a slave node "
+                           "past a master's end)",
                            {0.0, 1.0, true, false}});
   p.boundary_modification = section.get<bool>(
       "boundary_modification", true,

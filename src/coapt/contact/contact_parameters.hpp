@@ -11,7 +11,8 @@
 ///     search_distance: 0                  [m] 0: 10 × the mean slave facet size
 ///     relative_gap_tolerance: 1e-8        gaps below this × mean slave facet size are closed
 ///     coverage_threshold: 0.99999999      fraction of a slave node's support the master must
-///                                         cover for the node to be constrained
+///                                         cover for the node to be constrained (lower:
+///                                         partly covered nodes, mortar.hpp)
 ///     boundary_modification: true         no multipliers on the slave surface's boundary
 ///     max_active_set_changes: 30          Newton iterations in which the active set may
 ///                                         still change (then the step fails: cycling)

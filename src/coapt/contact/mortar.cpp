@@ -31,6 +31,14 @@ Point3 minus3(const Point3& a, const Point3& b) {
 /// facets).
 constexpr double kEmptyOverlap = 1e-12;
 
+/// A slave facet counts as wholly covered when the master covers this close to its measure
+/// (relative); its dual functions are then the standard ones.
+constexpr double kWholeFacet = 1e-8;
+/// A slave facet covered by less than this fraction of its measure adds nothing to the
+/// operators: its covered mass matrix is too near singular for the modified dual functions
+/// (only its coverage ∫_Γc N_j counts).
+constexpr double kMinFacetCoverage = 1e-3;
+
 /// Sorts entries by (row, column) and sums duplicates.
 std::vector<MortarEntry> merge(std::vector<MortarEntry> entries) {
   std::sort(entries.begin(), entries.end(), [](const MortarEntry& a, const MortarEntry& b) {
@@ -116,10 +124,43 @@ int integrate_triangles(const std::array<std::array<double, 3>, 3>& slave,
 }
 
 std::array<std::array<double, 3>, 3> dual_coefficients(int n_vertices,
-                                                       const std::array<bool, 3>& multiplier) {
+                                                       const std::array<bool, 3>& multiplier,
+                                                       const FacetMass* covered_mass) {
   std::array<std::array<double, 3>, 3> standard{}, result{};
-  for (int a = 0; a < n_vertices; ++a)
-    for (int b = 0; b < n_vertices; ++b) standard[a][b] = (a == b ? n_vertices + 1.0 : 0.0) - 1.0;
+  if (covered_mass == nullptr) {
+    for (int a = 0; a < n_vertices; ++a)
+      for (int b = 0; b < n_vertices; ++b) standard[a][b] = (a == b ? n_vertices + 1.0 : 0.0) - 1.0;
+  } else {
+    // A⁰ = diag(d) M⁻¹ with d_a = Σ_b M_ab: Gauss–Jordan with partial pivoting on [M | I].
+    const auto& M = *covered_mass;
+    double work[3][6] = {};
+    for (int a = 0; a < n_vertices; ++a)
+      for (int b = 0; b < n_vertices; ++b) {
+        work[a][b] = M[a][b];
+        work[a][n_vertices + b] = a == b ? 1.0 : 0.0;
+      }
+    for (int col = 0; col < n_vertices; ++col) {
+      int pivot = col;
+      for (int r = col + 1; r < n_vertices; ++r)
+        if (std::fabs(work[r][col]) > std::fabs(work[pivot][col])) pivot = r;
+      if (!(std::fabs(work[pivot][col]) > 0.0))
+        throw InternalError("dual_coefficients: singular covered mass matrix");
+      if (pivot != col)
+        for (int k = 0; k < 2 * n_vertices; ++k) std::swap(work[col][k], work[pivot][k]);
+      const double inverse = 1.0 / work[col][col];
+      for (int k = 0; k < 2 * n_vertices; ++k) work[col][k] *= inverse;
+      for (int r = 0; r < n_vertices; ++r) {
+        if (r == col) continue;
+        const double factor = work[r][col];
+        for (int k = 0; k < 2 * n_vertices; ++k) work[r][k] -= factor * work[col][k];
+      }
+    }
+    for (int a = 0; a < n_vertices; ++a) {
+      double d = 0.0;
+      for (int b = 0; b < n_vertices; ++b) d += M[a][b];
+      for (int b = 0; b < n_vertices; ++b) standard[a][b] = d * work[a][n_vertices + b];
+    }
+  }
   int n_multipliers = 0;
   for (int a = 0; a < n_vertices; ++a) n_multipliers += multiplier[a] ? 1 : 0;
   if (n_multipliers == 0) return result;
@@ -190,6 +231,8 @@ MortarOperators assemble_mortar(const Surface& slave, std::span<const double> sl
 
   std::vector<MortarEntry> slave_entries, master_entries;
   std::array<MortarPoint, kMaxMortarPoints> points;
+  std::vector<MortarPoint> facet_points;  // one slave facet's points, grouped by master facet
+  std::vector<int> facet_masters;
   const double distance = options.search_distance;
   for (int s = 0; s < slave.n_facets(); ++s) {
     const auto sv = slave.facet(s);
@@ -200,15 +243,7 @@ MortarOperators assemble_mortar(const Surface& slave, std::span<const double> sl
                          slave_normal[2] / slave_measure};
     std::array<bool, 3> carries{};
     for (int a = 0; a < dim; ++a) carries[a] = result.multiplier[sv[a]] != 0;
-    const auto A = dual_coefficients(dim, carries);
-    // Whole-facet integrals: ∫ N_a N_b = |s| (1 + δ_ab) / (n (n + 1)), ∫ N_a = |s| / n.
-    for (int a = 0; a < dim; ++a) {
-      result.support[sv[a]] += slave_measure / dim;
-      double d = 0.0;
-      for (int b = 0; b < dim; ++b)
-        d += A[a][b] * slave_measure * (a == b ? 2.0 : 1.0) / (dim * (dim + 1));
-      result.dual_mass[sv[a]] += d;
-    }
+    for (int a = 0; a < dim; ++a) result.support[sv[a]] += slave_measure / dim;
     // Slave facet box, grown by the search distance.
     double lower[3], upper[3];
     for (int i = 0; i < dim; ++i) {
@@ -220,6 +255,9 @@ MortarOperators assemble_mortar(const Surface& slave, std::span<const double> sl
         upper[i] = std::max(upper[i], x + distance);
       }
     }
+    // Every master facet facing this slave facet: its quadrature points on the overlap.
+    facet_points.clear();
+    facet_masters.clear();
     const double* origin = slave_x.data() + static_cast<std::size_t>(sv[0]) * dim;
     for (int m = 0; m < n_master_facets; ++m) {
       const double* mlower = box.data() + static_cast<std::size_t>(m) * 2 * dim;
@@ -262,11 +300,43 @@ MortarOperators assemble_mortar(const Surface& slave, std::span<const double> sl
       }
       if (n_points == 0) continue;
       ++result.facet_pairs;
-      double ds[3][3] = {}, dm[3][3] = {}, covered[3] = {};
       for (int q = 0; q < n_points; ++q) {
-        const auto& p = points[q];
+        facet_points.push_back(points[q]);
+        facet_masters.push_back(m);
+      }
+    }
+    // The covered part Γc ∩ s: its measure, ∫ N_a and mass matrix ∫ N_a N_b.
+    FacetMass covered_mass{};
+    double covered_measure = 0.0;
+    for (const auto& p : facet_points) {
+      covered_measure += p.weight;
+      for (int a = 0; a < dim; ++a)
+        for (int b = 0; b < dim; ++b) covered_mass[a][b] += p.weight * p.slave[a] * p.slave[b];
+    }
+    if (!(covered_measure >= kMinFacetCoverage * slave_measure)) continue;
+    for (const auto& p : facet_points)
+      for (int a = 0; a < dim; ++a) result.covered[sv[a]] += p.weight * p.slave[a];
+    // Dual functions biorthogonal on the covered part: the standard ones on a wholly covered
+    // facet, else those of the covered mass matrix (file comment).
+    const bool whole = std::fabs(covered_measure - slave_measure) <= kWholeFacet * slave_measure;
+    const auto A =
+        whole ? dual_coefficients(dim, carries) : dual_coefficients(dim, carries, &covered_mass);
+    if (whole)  // Whole-facet integrals: ∫ N_a N_b = |s| (1 + δ_ab) / (n (n + 1)).
+      for (int a = 0; a < dim; ++a) {
+        double d = 0.0;
+        for (int b = 0; b < dim; ++b)
+          d += A[a][b] * slave_measure * (a == b ? 2.0 : 1.0) / (dim * (dim + 1));
+        result.dual_mass[sv[a]] += d;
+      }
+    for (std::size_t begin = 0; begin < facet_points.size();) {
+      const int m = facet_masters[begin];
+      std::size_t end = begin;
+      while (end < facet_points.size() && facet_masters[end] == m) ++end;
+      const auto mv = master.facet(m);
+      double ds[3][3] = {}, dm[3][3] = {};
+      for (std::size_t q = begin; q < end; ++q) {
+        const auto& p = facet_points[q];
         for (int a = 0; a < dim; ++a) {
-          covered[a] += p.weight * p.slave[a];
           double phi = 0.0;
           for (int b = 0; b < dim; ++b) phi += A[a][b] * p.slave[b];
           for (int k = 0; k < dim; ++k) {
@@ -276,13 +346,14 @@ MortarOperators assemble_mortar(const Surface& slave, std::span<const double> sl
         }
       }
       for (int a = 0; a < dim; ++a) {
-        result.covered[sv[a]] += covered[a];
         if (!carries[a]) continue;
+        if (!whole) result.dual_mass[sv[a]] += ds[a][a];
         for (int k = 0; k < dim; ++k) {
           slave_entries.push_back({sv[a], sv[k], ds[a][k]});
           master_entries.push_back({sv[a], mv[k], dm[a][k]});
         }
       }
+      begin = end;
     }
   }
   result.slave_coupling = merge(std::move(slave_entries));

@@ -24,15 +24,30 @@
 /// affine on the clipped polygon and the degree-2 rules used (2 Gauss points on a segment,
 /// 3 points per triangle of the polygon's fan) integrate every product Φ_j N exactly.
 ///
+/// Partly covered slave facets (Popp, Seitz, Gee, Wall 2013, the dual functions of slave
+/// facets that project onto the master only in part): on a facet s whose overlap Γc ∩ s with
+/// the projected master is not the whole facet, the dual functions are made biorthogonal on
+/// the overlap instead of the whole facet,
+///   Φ_a = Σ_b A⁰_ab N_b,  A⁰ = diag(d) M⁻¹,  M_ab = ∫_Γc∩s N_a N_b,  d_a = Σ_b M_ab = ∫_Γc∩s N_a,
+/// then modified at the surface boundary as above. Σ_a Φ_a = 1 still holds (Mᵀ 1 = d), and
+/// on a wholly covered facet A⁰ is the standard (n + 1) I − 1. Every slave node's D̂ row is
+/// then diagonal on its multiplier nodes whatever the coverage, D_jj = ∫_Γc N_j, and a gap
+/// affine on each facet is reproduced at the node: g̃_j / D_jj = g(x_j), the overlap's gap
+/// extended to the node. With the standard functions on such a facet the part of Φ_j
+/// (3N_j − 1 < 0 near the far vertex) that the master covers can give g̃_j either sign
+/// whatever the gap, and D̂ is not diagonal: a node at a master's edge had no consistent
+/// normal force. Facets covered by less than 1e-3 of their measure add nothing, not even to
+/// the coverage ∫_Γc N_j (their covered mass matrix is too near singular).
+///
 /// The operators of the slave surface against one master surface:
-///   D_jj  = ∫_Γs Φ̃_j N_j (whole slave facets; diagonal)          dual_mass
+///   D_jj  = ∫_Γc Φ̃_j N_j = ∫_Γc N_j (diagonal)                      dual_mass
 ///   D̂_jk = ∫_Γc Φ̃_j N_k   (overlap Γc = Γs ∩ projected Γm)       slave_coupling
 ///   M_jl  = ∫_Γc Φ̃_j N^m_l                                        master_coupling
 ///   g̃_j  = n_j · (Σ_l M_jl x^m_l − Σ_k D̂_jk x^s_k) = ∫_Γc Φ̃_j n_j·(x^m − x^s)   weighted gap
-/// with n_j the averaged nodal normal (surface.hpp). On a slave node whose whole support is
-/// covered by the master, D̂_jk = δ_jk D_jj and Σ_l M_jl = D_jj (the master's partition of
-/// unity): constants are reproduced and the multiplier condenses out node by node. Only
-/// such nodes (covered fraction ≥ coverage_threshold) are constrained (contact.hpp).
+/// with n_j the averaged nodal normal (surface.hpp). On a multiplier node D̂_jk = δ_jk D_jj
+/// for multiplier nodes k, and Σ_l M_jl = D_jj (the master's partition of unity): constants
+/// are reproduced and the multiplier condenses out node by node. Only nodes whose covered
+/// fraction ∫_Γc N_j / ∫_Γs N_j reaches coverage_threshold are constrained (contact.hpp).
 
 #include <array>
 #include <span>
@@ -65,12 +80,18 @@ int integrate_segments(const std::array<std::array<double, 2>, 2>& slave,
 int integrate_triangles(const std::array<std::array<double, 3>, 3>& slave,
                         const std::array<std::array<double, 3>, 3>& master, MortarPoint* points);
 
+/// A facet's mass matrix ∫ N_a N_b over a part of it (n_vertices × n_vertices used).
+using FacetMass = std::array<std::array<double, 3>, 3>;
+
 /// Dual basis coefficients of a slave facet with `n_vertices` (2 or 3) vertices:
 /// Φ̃_a = Σ_b A[a][b] N_b. `multiplier[a]` says whether vertex a carries a multiplier;
 /// the dual functions of the other vertices are shared out equally to those that do (all
-/// zero when none does). With every vertex a multiplier node this is A = (n+1) I − 1.
+/// zero when none does). With every vertex a multiplier node this is A = (n+1) I − 1, the
+/// functions biorthogonal on the whole facet; with `covered_mass` (M over the covered part,
+/// regular) they are biorthogonal on that part: A⁰ = diag(M 1) M⁻¹ (file comment).
 std::array<std::array<double, 3>, 3> dual_coefficients(int n_vertices,
-                                                       const std::array<bool, 3>& multiplier);
+                                                       const std::array<bool, 3>& multiplier,
+                                                       const FacetMass* covered_mass = nullptr);
 
 /// Options of the mortar search and integration.
 struct MortarOptions {
@@ -79,7 +100,8 @@ struct MortarOptions {
   /// gap of a node that may come into contact within one Newton iteration, and stay below the
   /// thickness of the master body.
   double search_distance = 0.0;
-  /// A slave node is constrained when ∫_Γc N_j ≥ this · ∫_Γs N_j (its support is covered).
+  /// A slave node is constrained when ∫_Γc N_j ≥ this · ∫_Γs N_j (the default: its whole
+  /// support is covered; lower values let contact follow a slave node past a master's edge).
   double coverage_threshold = 1.0 - 1e-8;
   /// Boundary nodes of the slave surface carry no multiplier (see the file comment).
   bool boundary_modification = true;
@@ -98,20 +120,22 @@ struct MortarEntry {
 
 /// The mortar operators of a slave surface against a master surface (file comment).
 struct MortarOperators {
-  std::vector<double> normals;               ///< n_slave × dim averaged nodal normals
-  std::vector<char> multiplier;              ///< node carries a multiplier
-  std::vector<double> dual_mass;             ///< D_jj [m^(dim−1)] (0 where no multiplier)
-  std::vector<double> support;               ///< ∫_Γs N_j [m^(dim−1)]
-  std::vector<double> covered;               ///< ∫_Γc N_j [m^(dim−1)]
-  std::vector<double> weighted_gap;          ///< g̃_j [m^dim] (0 where no multiplier)
-  std::vector<MortarEntry> slave_coupling;   ///< D̂_jk, sorted by (row, column), summed
+  std::vector<double> normals;              ///< n_slave × dim averaged nodal normals
+  std::vector<char> multiplier;             ///< node carries a multiplier
+  std::vector<double> dual_mass;            ///< D_jj = ∫_Γc N_j [m^(dim−1)] (0: no multiplier)
+  std::vector<double> support;              ///< ∫_Γs N_j [m^(dim−1)]
+  std::vector<double> covered;              ///< ∫_Γc N_j [m^(dim−1)]
+  std::vector<double> weighted_gap;         ///< g̃_j [m^dim] (0 where no multiplier)
+  std::vector<MortarEntry> slave_coupling;  ///< D̂_jk, sorted by (row, column), summed
   std::vector<MortarEntry> master_coupling;  ///< M_jl, sorted by (row, column), summed
   long facet_pairs = 0;  ///< slave–master facet pairs with a non-empty overlap
   double coverage_threshold = 1.0;
 
-  /// Whether slave node j carries a multiplier and its support is covered (constrained).
+  /// Whether slave node j carries a multiplier and enough of its support is covered
+  /// (constrained).
   bool constrained(int j) const {
-    return multiplier[j] && support[j] > 0.0 && covered[j] >= coverage_threshold * support[j];
+    return multiplier[j] && support[j] > 0.0 && dual_mass[j] > 0.0 &&
+           covered[j] >= coverage_threshold * support[j];
   }
   /// The gap g̃_j / D_jj of a multiplier node [m].
   double gap(int j) const { return dual_mass[j] > 0.0 ? weighted_gap[j] / dual_mass[j] : 0.0; }

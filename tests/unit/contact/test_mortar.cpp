@@ -285,6 +285,116 @@ TEST(MortarOperators2D, PartlyCoveredNodesAreNotConstrained) {
   }
 }
 
+// Checks of a slave node j with a multiplier on partly covered facets: its D̂ row is diagonal
+// on the multiplier nodes (boundary nodes enter off the diagonal, like master nodes),
+// D_jj = ∫_Γc N_j, Σ_l M_jl = Σ_k D̂_jk, and the gap of a master plane is reproduced exactly:
+// g̃_j = Σ_k D̂_jk g(x_k), which is D_jj g(x_j) when no boundary node is near.
+template <class Gap>
+void expect_consistent_partial_node(const MortarOperators& op, const Surface& slave, int j,
+                                    Gap gap) {
+  SCOPED_TRACE(j);
+  const int dim = slave.dim;
+  double offdiagonal = 0, diagonal = 0, row_s = 0, row_m = 0, weighted = 0;
+  for (const auto& e : op.slave_coupling) {
+    if (e.row != j) continue;
+    if (e.column == j)
+      diagonal += e.value;
+    else if (op.multiplier[e.column])
+      offdiagonal += std::abs(e.value);
+    row_s += e.value;
+    weighted += e.value * gap(slave.reference.data() + dim * e.column);
+  }
+  for (const auto& e : op.master_coupling)
+    if (e.row == j) row_m += e.value;
+  EXPECT_GT(op.dual_mass[j], 0.0);
+  EXPECT_LT(offdiagonal, 1e-13 * op.support[j]);
+  EXPECT_NEAR(diagonal, op.dual_mass[j], 1e-14 * op.support[j]);
+  EXPECT_NEAR(op.dual_mass[j], op.covered[j], 1e-14 * op.support[j]);
+  EXPECT_NEAR(row_m, row_s, 1e-14 * op.support[j]);
+  EXPECT_NEAR(op.weighted_gap[j], weighted, 1e-14 * op.support[j]);
+  bool boundary_near = false;
+  for (const auto& e : op.slave_coupling)
+    boundary_near = boundary_near || (e.row == j && !op.multiplier[e.column]);
+  if (!boundary_near) {
+    EXPECT_NEAR(op.gap(j), gap(slave.reference.data() + dim * j), 1e-12);
+  }
+}
+
+TEST(MortarOperators2D, PartlyCoveredFacetsKeepDiagonalOperatorsAndExactGaps) {
+  // The slave [0, 1] (5 cells) over a master covering x ≥ 0.3, tilted: gap 0.03 + 0.1 x.
+  // Node 1 (x = 0.2) has 12.5 % of its support covered, node 2 (x = 0.4) 87.5 %. With the
+  // dual functions biorthogonal on the covered part each such node's gap is the tilted
+  // plane's at the node. The standard functions integrated over the overlap give node 1
+  // ∫_0.3^0.4 (3 N_1 − 1) (g) < 0: a penetration for a gap of 0.05 (checked below).
+  const auto upper = mesh::structured_rectangle(0.0, 0.05, 1.0, 1.0, 5, 2);
+  const auto lower = mesh::structured_rectangle(0.3, -1.0, 2.0, 0.0, 4, 2);
+  const Surface slave = group_surface(upper, "bottom");
+  const Surface master = group_surface(lower, "top");
+  const auto tilted = mapped(master, [](double* x) { x[1] += -0.1 * x[0] + 0.02; });
+  for (bool modification : {false, true}) {
+    SCOPED_TRACE(modification);
+    MortarOptions options;
+    options.search_distance = 0.5;  // the gap reaches 0.13
+    options.boundary_modification = modification;
+    options.coverage_threshold = 0.1;
+    const auto op = assemble_mortar(slave, slave.reference, master, tilted, options);
+    for (int j = 0; j < slave.n_nodes(); ++j) {
+      const double x = slave.reference[2 * j];
+      if (!op.multiplier[j]) {
+        EXPECT_EQ(op.dual_mass[j], 0.0);
+        continue;
+      }
+      if (x < 0.1 - 1e-12) {  // node 0: support [0, 0.2] uncovered
+        EXPECT_EQ(op.dual_mass[j], 0.0);
+        EXPECT_FALSE(op.constrained(j));
+        continue;
+      }
+      EXPECT_TRUE(op.constrained(j));
+      expect_consistent_partial_node(op, slave, j,
+                                     [](const double* y) { return 0.03 + 0.1 * y[0]; });
+    }
+  }
+  // The standard functions on node 1's covered part [0.3, 0.4] (N_1 = 2 − 5x there): the
+  // weighted gap they would give has the wrong sign for the open gap 0.03 + 0.1 x > 0.
+  double standard = 0;
+  for (double t : {0.35 - 0.05 / std::sqrt(3.0), 0.35 + 0.05 / std::sqrt(3.0)})
+    standard += 0.05 * (3.0 * (2.0 - 5.0 * t) - 1.0) * (0.03 + 0.1 * t);
+  EXPECT_LT(standard, 0.0);
+}
+
+TEST(MortarOperators3D, PartlyCoveredFacetsKeepDiagonalOperatorsAndExactGaps) {
+  // The slave [0,1]² (4×4 cells) over a tilted master rotated by 0.3 rad that covers only
+  // part of it (x ≥ about 0.37): gap 0.02 − 0.05 x + 0.03 y at every node with a covered
+  // part, whatever its fraction.
+  const auto upper = mesh::structured_box(0, 0, 0.02, 1, 1, 1, 4, 4, 1);
+  const auto lower = coapt::testing::rotated(
+      mesh::structured_box(0.4, -0.6, -1, 2.0, 1.6, 0, 5, 6, 1), 0.3, {0, 0, 1}, {0.5, 0.5, 0});
+  const Surface slave = group_surface(upper, "bottom");
+  const Surface master = group_surface(lower, "top");
+  const auto tilted = mapped(master, [](double* x) { x[2] += 0.05 * x[0] - 0.03 * x[1]; });
+  MortarOptions options;
+  options.search_distance = 0.1;
+  options.boundary_modification = false;
+  options.coverage_threshold = 1e-3;
+  const auto op = assemble_mortar(slave, slave.reference, master, tilted, options);
+  int partial = 0, whole = 0, none = 0;
+  for (int j = 0; j < slave.n_nodes(); ++j) {
+    const double fraction = op.covered[j] / op.support[j];
+    if (fraction > 1 - 1e-12)
+      ++whole;
+    else if (fraction > 0.0)
+      ++partial;
+    else
+      ++none;
+    if (op.dual_mass[j] > 0.0)
+      expect_consistent_partial_node(
+          op, slave, j, [](const double* y) { return 0.02 - 0.05 * y[0] + 0.03 * y[1]; });
+  }
+  EXPECT_GT(partial, 3);
+  EXPECT_GT(whole, 3);
+  EXPECT_GT(none, 0);
+}
+
 TEST(MortarOperators2D, BackFacingAndDistantMastersAreIgnored) {
   const auto upper = mesh::structured_rectangle(0.0, 0.0, 1.0, 1.0, 4, 2);
   const Surface slave = group_surface(upper, "bottom");
