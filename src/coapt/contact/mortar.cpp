@@ -3,6 +3,8 @@
 
 #include "coapt/contact/mortar.hpp"
 
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -131,35 +133,18 @@ std::array<std::array<double, 3>, 3> dual_coefficients(int n_vertices,
     for (int a = 0; a < n_vertices; ++a)
       for (int b = 0; b < n_vertices; ++b) standard[a][b] = (a == b ? n_vertices + 1.0 : 0.0) - 1.0;
   } else {
-    // A⁰ = diag(d) M⁻¹ with d_a = Σ_b M_ab: Gauss–Jordan with partial pivoting on [M | I].
-    const auto& M = *covered_mass;
-    double work[3][6] = {};
+    // A⁰ = diag(d) M⁻¹ with d_a = Σ_b M_ab (M symmetric positive definite).
+    using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3>;
+    Small M(n_vertices, n_vertices);
     for (int a = 0; a < n_vertices; ++a)
-      for (int b = 0; b < n_vertices; ++b) {
-        work[a][b] = M[a][b];
-        work[a][n_vertices + b] = a == b ? 1.0 : 0.0;
-      }
-    for (int col = 0; col < n_vertices; ++col) {
-      int pivot = col;
-      for (int r = col + 1; r < n_vertices; ++r)
-        if (std::fabs(work[r][col]) > std::fabs(work[pivot][col])) pivot = r;
-      if (!(std::fabs(work[pivot][col]) > 0.0))
-        throw InternalError("dual_coefficients: singular covered mass matrix");
-      if (pivot != col)
-        for (int k = 0; k < 2 * n_vertices; ++k) std::swap(work[col][k], work[pivot][k]);
-      const double inverse = 1.0 / work[col][col];
-      for (int k = 0; k < 2 * n_vertices; ++k) work[col][k] *= inverse;
-      for (int r = 0; r < n_vertices; ++r) {
-        if (r == col) continue;
-        const double factor = work[r][col];
-        for (int k = 0; k < 2 * n_vertices; ++k) work[r][k] -= factor * work[col][k];
-      }
-    }
-    for (int a = 0; a < n_vertices; ++a) {
-      double d = 0.0;
-      for (int b = 0; b < n_vertices; ++b) d += M[a][b];
-      for (int b = 0; b < n_vertices; ++b) standard[a][b] = d * work[a][n_vertices + b];
-    }
+      for (int b = 0; b < n_vertices; ++b) M(a, b) = (*covered_mass)[a][b];
+    const Eigen::LDLT<Small> factor(M);
+    if (factor.info() != Eigen::Success || !factor.isPositive())
+      throw InternalError("dual_coefficients: the covered mass matrix is not positive definite");
+    const Small inverse = factor.solve(Small::Identity(n_vertices, n_vertices));
+    const Eigen::VectorXd d = M.rowwise().sum();
+    for (int a = 0; a < n_vertices; ++a)
+      for (int b = 0; b < n_vertices; ++b) standard[a][b] = d(a) * inverse(a, b);
   }
   int n_multipliers = 0;
   for (int a = 0; a < n_vertices; ++a) n_multipliers += multiplier[a] ? 1 : 0;
