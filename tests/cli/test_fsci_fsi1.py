@@ -5,7 +5,9 @@ solid immersed in the fluid mesh, steady block Gauss-Seidel coupling), level 0:
  - the force on the bar B^T lambda balances the constraint reactions to round-off;
  - 2 ranks agree with 1 rank to 1e-6 relative in drag, lift and the displacement of A (the
    coupling stops at a relative change of 1e-6);
- - the drag (cylinder + bar) is within 10 % of the reference 14.295 N/m, and point A moves up
+ - the drag (cylinder + bar) is within 2 % of the reference 14.295 N/m (measured −0.37 %; when
+   the cylinder's no-slip vertices under the bar's end were constrained by the bar too, their
+   reaction was counted twice and the drag was 4.9 % low), and point A moves up
    as in the reference (its size, 3.7 mm against the reference's 0.82 mm, is not asserted: on
    this coarse level the bar's lift is far too large, see docs/verification/fsci.md);
  - the bar's volume changes by less than 1e-3 (it is loaded by the fluid only)."""
@@ -39,7 +41,7 @@ def main():
         print(f"{ranks} rank(s): drag {b['drag']:.5f} N/m, lift {b['lift']:.5f} N/m, u(A) = "
               f"({1e3 * b['displacement_x']:.5f}, {1e3 * b['displacement_y']:.5f}) mm, {iterations} coupling iterations")
         r.expect(b["force_balance_error"] < 1e-12, f"{ranks} rank(s): force balance ({b['force_balance_error']:.1e} < 1e-12)")
-        r.expect(b["drag_error"] < 0.10, f"{ranks} rank(s): drag within 10 % ({100 * b['drag_error']:.2f} %)")
+        r.expect(b["drag_error"] < 0.02, f"{ranks} rank(s): drag within 2 % ({100 * b['drag_error']:.2f} %)")
         r.expect(b["displacement_y"] > 0, f"{ranks} rank(s): A moves up")
         volume_change = abs(float(row["volume_bar"]) / (0.35101020514433644 * 0.02) - 1)
         r.expect(volume_change < 1e-3, f"{ranks} rank(s): bar volume change {volume_change:.1e} < 1e-3")

@@ -18,6 +18,10 @@ contact-stabilized Newmark with mortar contact, IQN-ILS reusing the last 4 steps
   cylinder moving at 0.1 m/s, 4 steps of 0.05 s; the constrained set changes every step):
   2 + 2 steps on 1 rank give steps 3..4 and the benchmark bit for bit (the body's position
   comes back from the checkpoint);
+- a step that fails (the same body, its inflow times a factor jumping to 1e300 at t = 0.15 s,
+  no retries) stops with exit status 1 and keeps the last good state (step 2) as a checkpoint:
+  restarted from the failed run's folder with the factor 1, steps 3..4 are the straight run's
+  bit for bit;
 - a checkpoint of a flow run and a checkpoint with other solids are refused with one error
   line naming the folder, exit 2.
 The fluid and the solid are solved by PETSc's own LU of the gathered matrix (ksp_type
@@ -106,6 +110,25 @@ def main():
         runner.expect(read_json(work / "rigid" / "summary.json")["benchmark"] ==
                       read_json(work / "rigid-again" / "summary.json")["benchmark"],
                       "moving rigid body: the benchmark bit for bit")
+
+    # A step that fails keeps the last good state as a checkpoint: the inflow times a factor
+    # that jumps to 1e300 at t = 0.15 s (step 3), no retries; restarted from the failed run's
+    # folder with the factor 1, steps 3..4 are the straight run's bit for bit.
+    blow_up = ["--set", "fluid.boundary[1].waveform.type=table",
+               "--set", "fluid.boundary[1].waveform.times=[0,0.125,0.15,1]",
+               "--set", "coupling.iteration.retries=0"]
+    failed = run_rigid("rigid-fails", 0.2, *blow_up, "--set", "fluid.boundary[1].waveform.values=[1,1,1e300,1e300]")
+    summary = read_json(work / "rigid-fails" / "summary.json")
+    runner.expect(failed.returncode == 1 and summary.get("status") == "failed"
+                  and summary.get("last_good_step") == 2 and "the last good state (step 2)" in failed.stdout,
+                  "a failed step: exit 1, summary failed, last good step 2 and where it is",
+                  failed.stdout[-2000:] + failed.stderr)
+    resumed = run_rigid("rigid-resumed", 0.2, *blow_up, "--set", "fluid.boundary[1].waveform.values=[1,1,1,1]",
+                        "--restart", work / "rigid-fails")
+    runner.expect(resumed.returncode == 0, "restart from the failed run succeeds", resumed.stderr[-2000:])
+    if resumed.returncode == 0 and (work / "rigid" / "series.csv").is_file():
+        runner.expect(read_rows(work / "rigid-resumed" / "series.csv") == read_rows(work / "rigid" / "series.csv")[2:],
+                      "restarted from the failed run's last good state: steps 3..4 bit for bit")
 
     def refused(result, what, needle):
         errors = [line for line in result.stderr.splitlines() if "error:" in line]

@@ -11,6 +11,11 @@ Newmark free vibration (cases/solid/vibration.yaml, 40 steps):
   300 on 1 rank gives steps 261..300 (active nodes, active-set changes, contact force, energy)
   and the impact benchmark bit for bit: the active set and the complementarity constant come
   back with the Newmark state;
+- a step whose Newton fails (the strip Neo-Hookean with a large velocity, at most 3 Newton
+  iterations: step 2 needs 4) stops with exit status 1 and one error line with the step's time
+  and |R| history, and keeps the last good state (step 1: its VTK and a checkpoint); restarted
+  from that folder with the default Newton settings, steps 2..5 are the straight run's bit for
+  bit (1 rank);
 - a missing checkpoint folder, a checkpoint of another mesh and a quasi-static case are refused
   with one error line naming the folder, exit 2."""
 
@@ -87,6 +92,32 @@ def main():
         runner.expect(read_json(work / "ball" / "summary.json")["benchmark"] ==
                       read_json(work / "ball-again" / "summary.json")["benchmark"],
                       "ball in a box: the benchmark (impacts, contact) bit for bit")
+
+    # A step whose Newton fails keeps the last good state: the Neo-Hookean strip with a large
+    # velocity needs 4 Newton iterations from step 2 on; with at most 3, step 2 fails.
+    hyperelastic = ["--set", "bodies[0].material.model=neo_hookean", "--set",
+                    "time.initial_velocity=[0,1]", "--set", "output.vtk=true", "--set",
+                    "output.vtk_interval=2"]
+    failed = run("fails", 0.05, *hyperelastic, "--set", "newton.max_iterations=3", ranks=1)
+    summary = read_json(work / "fails" / "summary.json")
+    errors = [line for line in failed.stderr.splitlines() if line.startswith("coapt: run failed:")]
+    runner.expect(failed.returncode == 1 and len(errors) == 1 and "t = 0.02 s" in errors[0]
+                  and "|R| = [" in errors[0] and summary.get("status") == "failed"
+                  and summary.get("last_good_step") == 1,
+                  "a failed step: exit 1, one error line with the step's time and |R| history, "
+                  "last good step 1", failed.stdout[-2000:] + failed.stderr)
+    pvd = (work / "fails" / "solid.pvd").read_text() if (work / "fails" / "solid.pvd").is_file() else ""
+    runner.expect('timestep="0.01"' in pvd and 'timestep="0.02"' not in pvd,
+                  "a failed step: the VTK of the last good step (0.01 s), not of the failed one", pvd)
+    results = [run("smooth", 0.05, *hyperelastic, ranks=1),
+               run("resumed", 0.05, *hyperelastic, "--restart", work / "fails", ranks=1)]
+    runner.expect(all(result.returncode == 0 for result in results),
+                  "the straight run and the restart from the failed run succeed",
+                  "\n".join(result.stderr for result in results))
+    if all(result.returncode == 0 for result in results):
+        runner.expect(read_rows(work / "resumed" / "series.csv") ==
+                      read_rows(work / "smooth" / "series.csv")[2:],
+                      "restarted from the failed run's last good state: steps 2..5 bit for bit")
 
     def refused(result, what, needle):
         errors = [line for line in result.stderr.splitlines() if "error:" in line]

@@ -6,6 +6,7 @@
 //  - after a Navier–Stokes solve with the body held at rest, the force on the solid Bᵀλ
 //    (λ = reaction / D) sums to the total constraint reaction to round-off, the drag is
 //    positive, and the constrained velocities are exactly zero;
+//  - a solid clamped to a wall leaves the wall's vertices to their no-slip condition;
 //  - FluidModel::restore_step repeats a step from the same history bit for bit (state and
 //    reactions), as the coupling iterations and step retries need.
 
@@ -129,6 +130,31 @@ TEST(CouplingConstraint, ForceOnSolidBalancesReactions) {
   if (coapt::rank_of(kWorld) == 0)
     std::printf("immersed square: force (%.10e, %.10e), %d constrained\n", total[0], total[1],
                 static_cast<int>(constraint.n_constrained()));
+}
+
+TEST(CouplingConstraint, WallVerticesAreLeftToTheirBoundaryCondition) {
+  // A square clamped to the bottom wall, [0.6, 1.0] × [−0.2, 0.3]: the wall's fluid vertices
+  // under it are covered, but their no-slip condition holds there and their reaction is the
+  // wall's, so that the body's force does not count it twice (FluidModel::
+  // velocity_condition_vertices, ImmersedConstraint's `fixed`).
+  FluidModel fluid(read_case(), kWorld);
+  fluid.start(0.0);
+  Mesh whole;
+  if (coapt::rank_of(kWorld) == 0)
+    whole = coapt::mesh::unstructured_rectangle(0.6, -0.2, 1.0, 0.3, 0.045);
+  const Mesh solid = coapt::mesh::distribute(whole, kWorld, coapt::mesh::Partitioner::blocks);
+  const auto fixed = fluid.velocity_condition_vertices();
+  ASSERT_EQ(fixed.size(), static_cast<std::size_t>(fluid.mesh().n_owned_vertices));
+  ImmersedConstraint all(fluid.mesh(), solid, {});
+  ImmersedConstraint free_only(fluid.mesh(), solid, {}, fixed);
+  // Wholly covered supports: x ∈ [0.65, 0.95] (7 columns), y ∈ [0, 0.25] (6 rows), of which
+  // the row y = 0 lies on the wall.
+  EXPECT_EQ(all.n_constrained(), 42);
+  EXPECT_EQ(free_only.n_constrained(), 35);
+  int on_wall = 0;
+  for (const int v : free_only.constrained_vertices())
+    on_wall += fixed[static_cast<std::size_t>(v)] != 0 || fluid.mesh().point(v)[1] < 1e-12;
+  EXPECT_EQ(sum_all(on_wall), 0.0);
 }
 
 /// PETSc options for the lifetime of a test (cleared afterwards: every MPI test shares one

@@ -527,9 +527,10 @@ class FsciProblem final : public run::Problem {
     fluid_.start(0.0);
     {
       ScopedTimer timer(output.timers(), "transfer");
+      const auto fixed = fluid_.velocity_condition_vertices();
       for (auto& solid : solids_) {
-        solid->constraint =
-            std::make_unique<ImmersedConstraint>(fluid_.mesh(), solid->mesh, parameters_.transfer);
+        solid->constraint = std::make_unique<ImmersedConstraint>(fluid_.mesh(), solid->mesh,
+                                                                 parameters_.transfer, fixed);
         solid->force = solid->constraint->create_solid_vector();
         if (!solid->model) continue;
         for (auto* v :
@@ -577,10 +578,18 @@ class FsciProblem final : public run::Problem {
         try {
           report = step_with_retries(output, dt);
         } catch (const ConvergenceError&) {
-          // step_with_retries restored the last committed state: its figures and fields
-          // stay in the run folder next to the failure
+          // step_with_retries restored the last committed state: its figures, fields and a
+          // checkpoint (to --restart from with other settings) stay in the run folder next to
+          // the failure
+          output.summary()["last_good_step"] = step;
+          output.summary()["last_good_time"] = fluid_.time();
           benchmark(output);
-          if (p.write_vtk) write_vtk(output, fluid_.time());
+          if (p.write_vtk && last_vtk_step != step) write_vtk(output, fluid_.time());
+          write_checkpoint(output, step);
+          log::error(
+              "the step from t = {:g} s failed; the last good state (step {}) is in {}: "
+              "--restart {} continues from it",
+              fluid_.time(), step, output.directory().string(), output.directory().string());
           throw;
         }
         ++step;
@@ -861,15 +870,21 @@ class FsciProblem final : public run::Problem {
   /// after `retries` failures the run fails with the history. The added-mass effect can make a
   /// smaller step worse, which is why the relaxation is tried first — unless a solid's solve
   /// failed in the first coupling iteration: its load there is the last step's force, which
-  /// the relaxation does not change, so that try would repeat exactly; the step is halved.
+  /// the relaxation does not change, so that try would repeat exactly; the step is halved. With
+  /// rigid solids alone (one pass, no relaxation) every retry halves the step.
   CouplingReport step_with_retries(run::RunOutput& output, double dt) {
     const auto& c = parameters_.coupling;
     double relaxation = c.relaxation, step = dt;
     std::string failures;
     bool relaxation_tried = false;
+    // a try moves the translating rigid solids (coupled_step): a failed one puts them back
+    std::vector<std::vector<double>> committed_coordinates;
+    for (const auto& solid : solids_)
+      committed_coordinates.push_back(solid->model ? std::vector<double>{}
+                                                   : solid->mesh.coordinates);
     for (int attempt = 0; attempt <= c.retries; ++attempt) {
       if (attempt > 0) {
-        if (!deformable_ || (!relaxation_tried && !first_solve_failed_)) {
+        if (deformable_ && !relaxation_tried && !first_solve_failed_) {
           relaxation *= 0.5;
           relaxation_tried = true;
         } else {
@@ -903,11 +918,16 @@ class FsciProblem final : public run::Problem {
                         relaxation, fmt::join(result.coupling.history, ", "));
       fluid_.restore_step();
       if (quasi_newton_) quasi_newton_->reset();
-      for (auto& solid : solids_)
-        if (solid->model) {
-          solid->model->restore();
-          COAPT_PETSC_CHECK(VecCopy(solid->applied_start, solid->applied));
+      for (std::size_t k = 0; k < solids_.size(); ++k) {
+        auto& solid = *solids_[k];
+        if (solid.model) {
+          solid.model->restore();
+          COAPT_PETSC_CHECK(VecCopy(solid.applied_start, solid.applied));
+        } else if (solid.mesh.coordinates != committed_coordinates[k]) {
+          solid.mesh.coordinates = committed_coordinates[k];
+          solid.constraint->update_solid(solid.mesh);
         }
+      }
     }
     throw ConvergenceError(fmt::format("fsci: the step from t = {:g} s failed after {} tries:{}",
                                        fluid_.time(), c.retries + 1, failures));

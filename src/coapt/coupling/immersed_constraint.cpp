@@ -9,13 +9,17 @@
 namespace coapt::coupling {
 
 ImmersedConstraint::ImmersedConstraint(const mesh::Mesh& fluid, const mesh::Mesh& solid,
-                                       const transfer::TransferOptions& options)
+                                       const transfer::TransferOptions& options,
+                                       std::vector<char> fixed)
     : fluid_(fluid),
       solid_(&solid),
-      transfer_(std::make_unique<transfer::VariationalTransfer>(fluid, solid, options)) {
+      transfer_(std::make_unique<transfer::VariationalTransfer>(fluid, solid, options)),
+      fixed_(std::move(fixed)) {
   if (fluid.dim != solid.dim)
     throw InputError(fmt::format("immersed solid {} is {}D in a {}D fluid ({})", solid.source,
                                  solid.dim, fluid.dim, fluid.source));
+  if (!fixed_.empty() && fixed_.size() != static_cast<std::size_t>(fluid.n_owned_vertices))
+    throw InternalError("immersed constraint: `fixed` must have one entry per owned fluid vertex");
   COAPT_PETSC_CHECK(VecCreateMPI(fluid.comm,
                                  static_cast<PetscInt>(fluid.n_owned_vertices) * fluid.dim,
                                  PETSC_DETERMINE, fluid_work_.out()));
@@ -57,6 +61,7 @@ void ImmersedConstraint::collect() {
   COAPT_PETSC_CHECK(VecGetArrayRead(transfer_->dual_mass(), &dual));
   for (const int v : vertices) {
     if (frozen_ && !(dual[v] > 0.0)) continue;  // no longer covered: T is not defined there
+    if (!fixed_.empty() && fixed_[static_cast<std::size_t>(v)]) continue;  // its own condition
     constrained_.push_back(v);
     dual_.push_back(dual[v]);
   }

@@ -38,8 +38,14 @@ namespace coapt::coupling {
 /// meshes' communicator. Both meshes must outlive the object.
 class ImmersedConstraint {
  public:
+  /// `fixed`: per owned fluid vertex, nonzero where the fluid has a velocity condition of its
+  /// own (a wall, an inlet; FluidModel::velocity_condition_vertices). Such a vertex is never
+  /// constrained: its boundary condition holds there, and its reaction is that boundary's
+  /// force. Were it constrained too, its reaction would also be the solid's load and be counted
+  /// twice in the body's force (a bar clamped to a body-fitted cylinder: the pressure inside the
+  /// bar on the cylinder's arc). Empty: no such vertex.
   ImmersedConstraint(const mesh::Mesh& fluid, const mesh::Mesh& solid,
-                     const transfer::TransferOptions& options);
+                     const transfer::TransferOptions& options, std::vector<char> fixed = {});
 
   /// The solid moved (same mesh, new coordinates): re-assembles B, D and the constrained set
   /// (while frozen: B and D only).
@@ -91,6 +97,7 @@ class ImmersedConstraint {
   std::unique_ptr<transfer::VariationalTransfer> transfer_;
   OwnedMat coupling_;             ///< B ⊗ I_dim (MAIJ view of the transfer's B)
   OwnedVec fluid_work_;           ///< fluid layout, dim components
+  std::vector<char> fixed_;       ///< per owned fluid vertex: a velocity condition of its own
   std::vector<int> constrained_;  ///< owned local fluid vertices
   std::vector<double> dual_;      ///< D_i at constrained_
   PetscInt n_constrained_ = 0;    ///< constrained_ summed over the ranks

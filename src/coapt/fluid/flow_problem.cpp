@@ -49,6 +49,7 @@ struct Parameters {
   TimeSettings time;
   Benchmark benchmark;
   bool write_vtk = true;
+  int vtk_interval = 0;         ///< transient: VTK every this many steps (0: the last step only)
   int checkpoint_interval = 0;  ///< transient: a checkpoint every this many steps (0: none)
 };
 
@@ -114,6 +115,10 @@ Parameters read(const config::Section& root) {
   }
   auto output = root.section("output", "what the run writes");
   p.write_vtk = output.get<bool>("vtk", true, {"", "write velocity and pressure as VTK"});
+  p.vtk_interval =
+      output.get<int>("vtk_interval", 0,
+                      {"", "transient: VTK every this many time steps (0: only at the end)",
+                       Bounds::closed(0, 1000000)});
   p.checkpoint_interval =
       output.get<int>("checkpoint_interval", 0,
                       {"", "transient: time steps between checkpoints for --restart (0: none)",
@@ -206,9 +211,12 @@ class FlowProblem final : public run::Problem {
         model_.begin_step(dt);
         const double time = model_.time();
         NewtonReport report;
-        {
+        try {
           ScopedTimer timer(output.timers(), "solve");
           report = model_.solve(fmt::format("step {} (t = {:g} s)", step, time));
+        } catch (const ConvergenceError&) {
+          keep_last_good_state(output, step - 1);
+          throw;
         }
         if (step <= 2 || step == n_steps)
           log::info("step {}: Newton residuals {:.3e}", step,
@@ -220,6 +228,11 @@ class FlowProblem final : public run::Problem {
         progress.step(
             step, time,
             fmt::format("newton {}, ksp {}", report.iterations, report.linear_iterations));
+        if (p.write_vtk && p.vtk_interval > 0 && step % p.vtk_interval == 0) {
+          ScopedTimer timer(output.timers(), "output");
+          model_.write_vtk(output, time);
+          last_vtk_step_ = step;
+        }
         if (p.checkpoint_interval > 0 && step % p.checkpoint_interval == 0) {
           ScopedTimer timer(output.timers(), "checkpoint");
           write_checkpoint(output);
@@ -234,13 +247,41 @@ class FlowProblem final : public run::Problem {
       ScopedTimer timer(output.timers(), "benchmark");
       benchmark(output);
     }
-    if (p.write_vtk) {
+    if (p.write_vtk && (p.time.steady || last_vtk_step_ != model_.steps())) {
       ScopedTimer timer(output.timers(), "output");
-      model_.write_vtk(output, p.time.steady ? 0.0 : p.time.end_time);
+      model_.write_vtk(output, p.time.steady ? 0.0 : model_.time());
     }
   }
 
  private:
+  /// After the Newton solve of a step failed (ConvergenceError, which the caller rethrows):
+  /// the trial state is dropped, and the run folder keeps the last committed state next to
+  /// the failure: its benchmark figures, its VTK fields (unless that step's are written
+  /// already) and a checkpoint, so that `--restart DIR` (with a smaller `time.step`, say)
+  /// continues from it. Nothing of the failed trial state is written.
+  void keep_last_good_state(run::RunOutput& output, int last_step) {
+    const auto& p = parameters_;
+    model_.restore_step();
+    auto& summary = output.summary();
+    summary["last_good_step"] = last_step;
+    summary["last_good_time"] = model_.time();
+    model_.write_windkessel_states(output);
+    try {
+      benchmark(output);
+    } catch (const Error& error) {
+      // the step's failure is what the run reports; a benchmark that cannot be evaluated on
+      // the short history is recorded beside it
+      summary["benchmark_error"] = error.what();
+    }
+    if (p.write_vtk && last_vtk_step_ != last_step) model_.write_vtk(output, model_.time());
+    write_checkpoint(output);
+    log::error(
+        "step {} failed; the last good state (step {}, t = {:g} s) is in {}{}: "
+        "--restart {} continues from it",
+        last_step + 1, last_step, model_.time(), output.directory().string(),
+        p.write_vtk ? " (VTK and checkpoint)" : " (checkpoint)", output.directory().string());
+  }
+
   /// The model's history and the benchmark histories into output/checkpoint.
   void write_checkpoint(run::RunOutput& output) const {
     run::CheckpointWriter writer(comm_, output.directory() / "checkpoint");
@@ -551,6 +592,7 @@ class FlowProblem final : public run::Problem {
   /// benchmark's coefficients or forces).
   std::vector<double> history_body_time_, history_drag_, history_lift_;
   const run::CheckpointReader* restart_ = nullptr;
+  int last_vtk_step_ = -1;  ///< transient: the last step whose VTK fields are written
 };
 
 }  // namespace

@@ -541,6 +541,14 @@ double FluidModel::kinetic_energy() const {
   return 0.5 * parameters_.fluid.density * energy;
 }
 
+std::vector<char> FluidModel::velocity_condition_vertices() const {
+  if (condition_of_vertex_.size() != static_cast<std::size_t>(mesh_.n_owned_vertices))
+    throw InternalError("FluidModel::velocity_condition_vertices before start()");
+  std::vector<char> fixed(condition_of_vertex_.size(), 0);
+  for (std::size_t v = 0; v < fixed.size(); ++v) fixed[v] = condition_of_vertex_[v] >= 0 ? 1 : 0;
+  return fixed;
+}
+
 void FluidModel::setup_dirichlet() {
   const int dim = mesh_.dim, n = dim + 1;
   condition_of_vertex_.assign(static_cast<std::size_t>(mesh_.n_owned_vertices), -1);

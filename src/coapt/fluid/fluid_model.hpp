@@ -141,6 +141,9 @@ class FluidModel {
   /// Logs the mesh, its quality and the material. Not collective (rank 0 logs).
   void describe(const std::string& title) const;
 
+  /// Per owned vertex, 1 where a velocity condition of `boundary` (velocity, no_slip) holds,
+  /// else 0 (after start()). Not collective.
+  std::vector<char> velocity_condition_vertices() const;
   /// Facet tag of the boundary group `name`; InputError naming `key` and the groups there are.
   int boundary_tag(const std::string& name, const std::string& key) const;
 

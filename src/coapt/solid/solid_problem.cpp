@@ -394,9 +394,33 @@ class SolidProblem final : public run::Problem {
 
     int total_newton = 0, total_linear = 0;
     Progress progress(time.n_steps, time.end_time, (first_step - 1) * time.step);
+    // A step whose Newton fails: the trial state is dropped and the run folder keeps the last
+    // committed one beside the failure (its fields unless written already, a checkpoint to
+    // --restart from); the caller marks the run failed.
+    const auto keep_last_good_state = [&](int last_step) {
+      solid_.restore();
+      const double last_time = last_step * time.step;
+      output.summary()["last_good_step"] = last_step;
+      output.summary()["last_good_time"] = last_time;
+      const bool written =
+          last_step % parameters().vtk_interval == 0 && (last_step >= first_step || !restart_);
+      if (parameters().write_vtk && !written) write_vtk(output, last_time);
+      checkpoint(last_step, last_time);
+      log::error(
+          "step {} failed; the last good state (step {}, t = {:g} s) is in {}: "
+          "--restart {} continues from it",
+          last_step + 1, last_step, last_time, output.directory().string(),
+          output.directory().string());
+    };
     for (int step = first_step; step <= time.n_steps; ++step) {
       const double t = step * time.step;
-      const auto report = solid_.step(t, time.step, output);
+      StepReport report;
+      try {
+        report = solid_.step(t, time.step, output);
+      } catch (const ConvergenceError&) {
+        keep_last_good_state(step - 1);
+        throw;
+      }
       solid_.commit();
       total_newton += report.newton_iterations;
       total_linear += report.linear_iterations;
