@@ -10,9 +10,14 @@ without a hole, the cylinder a separate solid mesh held at rest by the velocity 
    closer to the reference on level 0;
  - a transient run with the body translating moves the solid (the constrained set changes)
    and keeps the force balance;
+ - two solids that share fluid nodes (coupling::ConstraintGroup): the disc cut along y = 0.2
+   into two half-disc solids (tests/data/meshes/half_disk_*.geo, with the disc's own arcs)
+   constrains the fluid as the whole disc: the sum of the halves' forces equals the disc's
+   force to 1e-8 relative, the nodes along the cut count in both halves (more constrained
+   nodes in the two than in the disc), the balance holds, and 2 ranks agree with 1;
  - a benchmark body that names no solid is an input error naming the key."""
 
-from cli_common import Runner, parse_arguments, read_json
+from cli_common import Runner, parse_arguments, read_json, read_rows
 
 DIRECT = ["-fluid_ksp_type", "preonly", "-fluid_pc_type", "lu", "-fluid_pc_factor_mat_solver_type", "mumps"]
 
@@ -30,6 +35,45 @@ def run_case(r, name, level=0, ranks=1, extra=()):
 
 def relative(a, b):
     return abs(a - b) / max(abs(b), 1e-300)
+
+
+def two_halves(r, disc):
+    """The disc as two half-disc solids against the disc's run (`disc`: its benchmark, 1 rank)."""
+    source = r.source.resolve()
+    text = (source / "cases" / "dfg" / "2d1_immersed.yaml").read_text()
+    text = text.replace("file: channel_filled.geo", f"file: {source / 'cases' / 'dfg' / 'channel_filled.geo'}")
+    solids = text[text.index("solids:"):text.index("coupling:")]
+    halves = "solids:\n" + "".join(
+        f"  - name: {half}\n    rigid: true\n    mesh:\n      type: geo\n"
+        f"      file: {source / 'tests' / 'data' / 'meshes' / f'half_disk_{half}.geo'}\n      size: 0.005\n"
+        for half in ("upper", "lower"))
+    text = text.replace(solids, halves).replace("body: cylinder", "body: upper")
+    case = r.work / "two_halves.yaml"
+    case.write_text(text)
+    rows = {}
+    for ranks in (1, 2):
+        out = r.work / f"halves-np{ranks}"
+        result = r.run("run", case, "--output", out, "--set", "output.vtk=false", "--", *DIRECT, ranks=ranks)
+        r.expect(result.returncode == 0, f"two half discs on {ranks} rank(s) run", result.stdout[-2000:] + result.stderr)
+        if result.returncode != 0:
+            return
+        rows[ranks] = read_rows(out / "series.csv")[-1]
+        balance = read_json(out / "summary.json")["benchmark"]["force_balance_error"]
+        r.expect(balance < 1e-12, f"two half discs on {ranks} rank(s): force balance {balance:.1e} < 1e-12")
+    one, two = rows[1], rows[2]
+    total = [float(one[f"force_{c}_upper"]) + float(one[f"force_{c}_lower"]) for c in "xy"]
+    shared = int(float(one["constrained_upper"])) + int(float(one["constrained_lower"]))
+    if disc is not None:
+        whole = disc["solids"]["cylinder"]
+        print(f"two half discs: force ({total[0]:.10e}, {total[1]:.10e}), the disc ({whole['force'][0]:.10e}, "
+              f"{whole['force'][1]:.10e}); constrained {shared} in the halves, {whole['constrained_fluid_vertices']} "
+              f"in the disc")
+        r.expect(relative(total[0], whole["force"][0]) < 1e-8 and abs(total[1] - whole["force"][1]) < 1e-8 * abs(whole["force"][0]),
+                 "two half discs: their forces sum to the disc's force (1e-8)")
+        r.expect(shared > whole["constrained_fluid_vertices"],
+                 "two half discs: the nodes along the cut are constrained by both")
+    worst = max(relative(float(two[k]), float(one[k])) for k in ("force_x_upper", "force_x_lower"))
+    r.expect(worst < 1e-8, f"two half discs: 2 ranks agree with 1 ({worst:.1e} < 1e-8)")
 
 
 def main():
@@ -86,6 +130,8 @@ def main():
         balance = [float(row.split(",")[header.index("force_balance")]) for row in rows[1:]]
         r.expect(len(rows) == 5, "moving body: 4 steps in series.csv")
         r.expect(max(balance) < 1e-12, f"moving body: force balance every step ({max(balance):.1e} < 1e-12)")
+
+    two_halves(r, results.get(1))
 
     bad = r.run("run", r.source / "cases" / "dfg" / "2d1_immersed.yaml", "--output", r.work / "bad",
                 "--set", "benchmark.body=cylindre")

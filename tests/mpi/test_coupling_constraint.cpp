@@ -7,6 +7,8 @@
 //    (λ = reaction / D) sums to the total constraint reaction to round-off, the drag is
 //    positive, and the constrained velocities are exactly zero;
 //  - a solid clamped to a wall leaves the wall's vertices to their no-slip condition;
+//  - two solids that together cover the square (coupling::ConstraintGroup) are constrained as
+//    the square: the same vertices, a linear velocity exactly, the same total force;
 //  - FluidModel::restore_step repeats a step from the same history bit for bit (state and
 //    reactions), as the coupling iterations and step retries need.
 
@@ -20,6 +22,7 @@
 
 #include "coapt/core/config.hpp"
 #include "coapt/core/context.hpp"
+#include "coapt/coupling/constraint_group.hpp"
 #include "coapt/coupling/immersed_constraint.hpp"
 #include "coapt/fem/assembly.hpp"
 #include "coapt/fluid/fluid_model.hpp"
@@ -28,6 +31,7 @@
 
 namespace {
 
+using coapt::coupling::ConstraintGroup;
 using coapt::coupling::ImmersedConstraint;
 using coapt::fluid::FluidCase;
 using coapt::fluid::FluidModel;
@@ -155,6 +159,76 @@ TEST(CouplingConstraint, WallVerticesAreLeftToTheirBoundaryCondition) {
   for (const int v : free_only.constrained_vertices())
     on_wall += fixed[static_cast<std::size_t>(v)] != 0 || fluid.mesh().point(v)[1] < 1e-12;
   EXPECT_EQ(sum_all(on_wall), 0.0);
+}
+
+Mesh distributed_rectangle(double x0, double y0, double x1, double y1) {
+  Mesh whole;
+  if (coapt::rank_of(kWorld) == 0)
+    whole = coapt::mesh::unstructured_rectangle(x0, y0, x1, y1, 0.045);
+  return coapt::mesh::distribute(whole, kWorld, coapt::mesh::Partitioner::blocks);
+}
+
+TEST(CouplingConstraint, TwoSolidsCoveringOneBodyAreConstrainedAsTheBody) {
+  // The square cut into two solids at x = 0.8 (a line of fluid vertices): alone, each covers
+  // the whole support of 3 × 7 fluid vertices, and the column x = 0.8 half; together
+  // (ConstraintGroup: B and D summed) they constrain the square's 7 × 7 vertices, transfer a
+  // linear velocity given on both exactly, and take the same total force as the square.
+  FluidModel fluid(read_case(), kWorld);
+  fluid.start(0.0);
+  const Mesh square = solid_square();
+  const Mesh left = distributed_rectangle(0.6, 0.3, 0.8, 0.7);
+  const Mesh right = distributed_rectangle(0.8, 0.3, 1.0, 0.7);
+  ImmersedConstraint body(fluid.mesh(), square, {});
+  ImmersedConstraint a(fluid.mesh(), left, {}), b(fluid.mesh(), right, {});
+  EXPECT_EQ(a.n_constrained(), 21);
+  EXPECT_EQ(b.n_constrained(), 21);
+  ConstraintGroup group(fluid.mesh(), {&a, &b},
+                        coapt::transfer::TransferOptions{}.coverage_threshold);
+  group.combine();
+  EXPECT_EQ(a.n_constrained(), 28) << "the shared column joins both";
+  EXPECT_EQ(b.n_constrained(), 28);
+  group.combine();  // idempotent
+  EXPECT_EQ(a.n_constrained(), 28);
+  const auto merged = group.merge({a.transfer_velocity(linear_velocity(a, left)),
+                                   b.transfer_velocity(linear_velocity(b, right))});
+  EXPECT_EQ(merged.vertices, body.constrained_vertices()) << "the square's vertices, each once";
+  double error = 0;
+  for (std::size_t q = 0; q < merged.vertices.size(); ++q) {
+    const double x = fluid.mesh().point(merged.vertices[q])[0];
+    const double y = fluid.mesh().point(merged.vertices[q])[1];
+    error = std::max({error, std::abs(merged.velocities[2 * q] - (0.3 + 1.5 * x - 0.7 * y)),
+                      std::abs(merged.velocities[2 * q + 1] - (-0.2 + 0.7 * x))});
+  }
+  MPI_Allreduce(MPI_IN_PLACE, &error, 1, MPI_DOUBLE, MPI_MAX, kWorld);
+  EXPECT_LT(error, 1e-12);
+
+  // At rest: the same fluid problem as the square's, so the same total force.
+  const std::vector<double> zero_a(a.constrained_vertices().size() * 2, 0.0);
+  const std::vector<double> zero_b(b.constrained_vertices().size() * 2, 0.0);
+  const auto at_rest = group.merge({zero_a, zero_b});
+  fluid.set_velocity_constraint(at_rest.vertices, at_rest.velocities);
+  fluid.solve_steady("two solids");
+  const auto reactions = fluid.constraint_reactions();
+  std::vector<double> total(2, 0.0);
+  for (std::size_t k = 0; k < 2; ++k) {
+    auto& constraint = k == 0 ? a : b;
+    const auto own = group.reactions_of(k, reactions);
+    auto force = constraint.create_solid_vector();
+    constraint.solid_force(constraint.multiplier(own), force);
+    const auto sum = constraint.sum_components(force);
+    const auto balance = constraint.sum_constrained(own);
+    for (int i = 0; i < 2; ++i) {
+      EXPECT_NEAR(sum[i], balance[i], 1e-12 * std::abs(balance[0])) << "solid " << k;
+      total[i] += sum[i];
+    }
+  }
+  fluid.set_velocity_constraint(body.constrained_vertices(),
+                                body.transfer_uniform_velocity({0.0, 0.0}));
+  fluid.solve_steady("the square");
+  const auto square_reaction = body.sum_constrained(fluid.constraint_reactions());
+  for (int i = 0; i < 2; ++i)
+    EXPECT_NEAR(total[i], square_reaction[i], 1e-9 * std::abs(square_reaction[0]))
+        << "component " << i;
 }
 
 /// PETSc options for the lifetime of a test (cleared afterwards: every MPI test shares one

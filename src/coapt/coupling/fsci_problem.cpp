@@ -14,6 +14,7 @@
 #include "coapt/core/error.hpp"
 #include "coapt/core/log.hpp"
 #include "coapt/core/progress.hpp"
+#include "coapt/coupling/constraint_group.hpp"
 #include "coapt/coupling/immersed_constraint.hpp"
 #include "coapt/coupling/quasi_newton.hpp"
 #include "coapt/fem/assembly.hpp"
@@ -332,8 +333,7 @@ struct Solid {
   std::unique_ptr<contact::ContactHook> contact;  ///< deformable with `contact:`
   mesh::Mesh mesh;  ///< the current configuration (rigid: moved in place; deformable: X + u)
   std::unique_ptr<ImmersedConstraint> constraint;
-  std::size_t first = 0;  ///< offset of its vertices in the fluid's constrained list
-  OwnedVec force;         ///< Bᵀλ of the last fluid solve (solid vertex vector, dim components)
+  OwnedVec force;  ///< Bᵀλ of the last fluid solve (solid vertex vector, dim components)
   std::vector<double> total_force;
   // deformable: the force the solid is loaded with (relaxed), its value at the step's start,
   // and the last residual f − f_applied (Aitken)
@@ -528,9 +528,11 @@ class FsciProblem final : public run::Problem {
     {
       ScopedTimer timer(output.timers(), "transfer");
       const auto fixed = fluid_.velocity_condition_vertices();
+      std::vector<ImmersedConstraint*> constraints;
       for (auto& solid : solids_) {
         solid->constraint = std::make_unique<ImmersedConstraint>(fluid_.mesh(), solid->mesh,
                                                                  parameters_.transfer, fixed);
+        constraints.push_back(solid->constraint.get());
         solid->force = solid->constraint->create_solid_vector();
         if (!solid->model) continue;
         for (auto* v :
@@ -541,6 +543,9 @@ class FsciProblem final : public run::Problem {
         }
         solid->model->set_external_force(solid->applied);
       }
+      group_ = std::make_unique<ConstraintGroup>(fluid_.mesh(), constraints,
+                                                 parameters_.transfer.coverage_threshold, fixed);
+      group_->combine();
     }
     const auto& p = parameters_;
     if (!p.time.steady)
@@ -928,6 +933,7 @@ class FsciProblem final : public run::Problem {
           solid.constraint->update_solid(solid.mesh);
         }
       }
+      group_->combine();
     }
     throw ConvergenceError(fmt::format("fsci: the step from t = {:g} s failed after {} tries:{}",
                                        fluid_.time(), c.retries + 1, failures));
@@ -958,6 +964,7 @@ class FsciProblem final : public run::Problem {
         solid->update_configuration();
       }
     }
+    if (c.freeze_after == 1) group_->combine();  // the set frozen below is the group's
     double omega = relaxation, first_norm = 0;
     bool fell_back = false;  // the last update was the relaxed fallback of a failed solid solve
     for (int iteration = 1; iteration <= (deformable_ ? c.max_iterations : 1); ++iteration) {
@@ -1131,36 +1138,24 @@ class FsciProblem final : public run::Problem {
     }
   }
 
-  /// v_f = T v_s at every solid's constrained fluid nodes (steady deformable solids: v_s = 0).
-  /// A fluid node constrained by two solids is an error for now (the valve will need a rule:
-  /// notes.md "Thin solids").
+  /// v_f = T v_s at every solid's constrained fluid nodes (steady deformable solids: v_s = 0);
+  /// at a node several solids cover, the sum of their shares (ConstraintGroup: the projection
+  /// from the union of the solids).
   void apply_constraint(bool steady) {
     const int dim = fluid_.mesh().dim;
-    std::vector<int> vertices;
-    std::vector<double> velocities;
+    group_->combine();
+    std::vector<std::vector<double>> shares;
     for (auto& solid : solids_) {
-      solid->first = vertices.size();
-      const auto& constrained = solid->constraint->constrained_vertices();
-      std::vector<double> values;
       if (solid->model && !steady) {
-        values = solid->constraint->transfer_velocity(solid->model->velocity());
+        shares.push_back(solid->constraint->transfer_velocity(solid->model->velocity()));
       } else {
         const auto& velocity = solid->entry->velocity;
-        values = solid->constraint->transfer_uniform_velocity(
-            velocity.empty() ? std::vector<double>(static_cast<std::size_t>(dim), 0.0) : velocity);
+        shares.push_back(solid->constraint->transfer_uniform_velocity(
+            velocity.empty() ? std::vector<double>(static_cast<std::size_t>(dim), 0.0) : velocity));
       }
-      vertices.insert(vertices.end(), constrained.begin(), constrained.end());
-      velocities.insert(velocities.end(), values.begin(), values.end());
     }
-    auto sorted = vertices;
-    std::sort(sorted.begin(), sorted.end());
-    int shared = std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end() ? 1 : 0;
-    MPI_Allreduce(MPI_IN_PLACE, &shared, 1, MPI_INT, MPI_MAX, comm_);
-    if (shared)
-      throw InputError(
-          "solids: two solids constrain the same fluid node (overlapping solids are not "
-          "supported yet)");
-    fluid_.set_velocity_constraint(vertices, velocities);
+    const auto merged = group_->merge(shares);
+    fluid_.set_velocity_constraint(merged.vertices, merged.velocities);
   }
 
   /// λ = r/D and Bᵀλ of every solid from the fluid's constraint reactions; the balance
@@ -1169,11 +1164,9 @@ class FsciProblem final : public run::Problem {
     const int dim = fluid_.mesh().dim;
     const auto reactions = fluid_.constraint_reactions();
     force_balance_ = 0;
-    for (auto& solid : solids_) {
-      const auto n = solid->constraint->constrained_vertices().size() * dim;
-      const std::vector<double> own(
-          reactions.begin() + static_cast<std::ptrdiff_t>(solid->first),
-          reactions.begin() + static_cast<std::ptrdiff_t>(solid->first + n));
+    for (std::size_t k = 0; k < solids_.size(); ++k) {
+      auto& solid = solids_[k];
+      const auto own = group_->reactions_of(k, reactions);
       const auto lambda = solid->constraint->multiplier(own);
       solid->constraint->solid_force(lambda, solid->force);
       fem::update_ghosts(solid->force);
@@ -1499,8 +1492,9 @@ class FsciProblem final : public run::Problem {
   MPI_Comm comm_;
   fluid::FluidModel fluid_;
   std::vector<std::unique_ptr<Solid>> solids_;
-  double force_balance_ = 0;         ///< max over solids of the relative force balance error
-  bool deformable_ = false;          ///< some solid is deformable: coupling iterations
+  std::unique_ptr<ConstraintGroup> group_;  ///< the solids' constraints together (after start)
+  double force_balance_ = 0;                ///< max over solids of the relative force balance error
+  bool deformable_ = false;                 ///< some solid is deformable: coupling iterations
   bool first_solve_failed_ = false;  ///< the last try failed in a solid's first solve of the step
   std::unique_ptr<InterfaceQuasiNewton> quasi_newton_;  ///< coupling.iteration.method iqn_ils
   int last_columns_ = 0;                                ///< columns of the last IQN-ILS update

@@ -60,12 +60,31 @@ void ImmersedConstraint::collect() {
   const PetscScalar* dual = nullptr;
   COAPT_PETSC_CHECK(VecGetArrayRead(transfer_->dual_mass(), &dual));
   for (const int v : vertices) {
-    if (frozen_ && !(dual[v] > 0.0)) continue;  // no longer covered: T is not defined there
+    // no longer covered: T is not defined there (in a group: the summed D_i decides)
+    if (frozen_ && !shared_ && !(dual[v] > 0.0)) continue;
     if (!fixed_.empty() && fixed_[static_cast<std::size_t>(v)]) continue;  // its own condition
     constrained_.push_back(v);
     dual_.push_back(dual[v]);
   }
   COAPT_PETSC_CHECK(VecRestoreArrayRead(transfer_->dual_mass(), &dual));
+  own_dual_ = dual_;
+  count_constrained();
+}
+
+void ImmersedConstraint::assign(std::vector<int> vertices, std::vector<double> total_dual) {
+  if (vertices.size() != total_dual.size())
+    throw InternalError("immersed constraint: one summed D_i per constrained vertex");
+  constrained_ = std::move(vertices);
+  dual_ = std::move(total_dual);
+  own_dual_.clear();
+  const PetscScalar* dual = nullptr;
+  COAPT_PETSC_CHECK(VecGetArrayRead(transfer_->dual_mass(), &dual));
+  for (const int v : constrained_) own_dual_.push_back(dual[v]);
+  COAPT_PETSC_CHECK(VecRestoreArrayRead(transfer_->dual_mass(), &dual));
+  count_constrained();
+}
+
+void ImmersedConstraint::count_constrained() {
   long long count = static_cast<long long>(constrained_.size());
   MPI_Allreduce(MPI_IN_PLACE, &count, 1, MPI_LONG_LONG, MPI_SUM, fluid_.comm);
   n_constrained_ = static_cast<PetscInt>(count);
@@ -142,8 +161,14 @@ std::vector<double> ImmersedConstraint::sum_components(Vec solid_vector) const {
 
 std::vector<double> ImmersedConstraint::sum_constrained(const std::vector<double>& values) const {
   const int dim = fluid_.dim;
+  if (values.size() != constrained_.size() * dim)
+    throw InternalError("immersed constraint: values must be constrained vertices × dim");
   std::vector<double> sum(static_cast<std::size_t>(dim), 0.0);
-  for (std::size_t k = 0; k < values.size(); ++k) sum[k % dim] += values[k];
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    const std::size_t q = k / static_cast<std::size_t>(dim);
+    // x · (D_k,i / D_i) is x itself when the node is not shared (D_k,i = D_i)
+    sum[k % dim] += own_dual_[q] == dual_[q] ? values[k] : values[k] * own_dual_[q] / dual_[q];
+  }
   MPI_Allreduce(MPI_IN_PLACE, sum.data(), dim, MPI_DOUBLE, MPI_SUM, fluid_.comm);
   return sum;
 }

@@ -20,6 +20,11 @@
 /// (TransferOptions::coverage_threshold): by default those whose whole support lies in the
 /// solid, where biorthogonality makes T exact for linear fields. Vectors are interleaved
 /// vertex vectors (vertex v, component i at v·dim + i) in the PETSc layouts of the meshes.
+///
+/// With several solids a fluid node may be covered by more than one (leaflets in contact, a
+/// leaflet sewn to a stent): coupling::ConstraintGroup then replaces D_i by the solids' sum
+/// D_i = Σ_k D_k,i in the formulas above (assign()), so that each solid's transfer_velocity()
+/// is its share (B_k v_k)_i / D_i of the node's velocity and multiplier() the node's λ_i.
 
 #include <petscmat.h>
 #include <petscvec.h>
@@ -62,6 +67,13 @@ class ImmersedConstraint {
   /// applied again) and the frozen flag it had.
   void restore(const mesh::Mesh& moved, std::vector<int> constrained, bool frozen);
 
+  /// Part of a ConstraintGroup of several solids: a frozen set keeps its nodes whatever this
+  /// solid's own D_k,i (the group drops a node whose summed D_i is not positive).
+  void set_shared(bool shared) { shared_ = shared; }
+  /// The group's decision (ConstraintGroup::combine): this solid's constrained vertices (owned
+  /// local fluid vertices, ascending) and the summed D_i = Σ_k D_k,i of each. Collective.
+  void assign(std::vector<int> vertices, std::vector<double> total_dual);
+
   /// Owned local fluid vertices of the constrained set, ascending.
   const std::vector<int>& constrained_vertices() const { return constrained_; }
   /// Number of constrained fluid vertices over all ranks.
@@ -84,13 +96,16 @@ class ImmersedConstraint {
 
   /// Σ over all nodes of a solid vertex vector with dim components (e.g. the total force).
   std::vector<double> sum_components(Vec solid_vector) const;
-  /// Σ over all ranks of a constrained-vertex array (e.g. the total reaction).
+  /// Σ over all ranks of a constrained-vertex array (e.g. the total reaction), each vertex's
+  /// entries weighted by this solid's share D_k,i / D_i (1 unless the node is shared): for the
+  /// reactions, what Σ Bᵀλ of this solid balances.
   std::vector<double> sum_constrained(const std::vector<double>& values) const;
 
   const transfer::VariationalTransfer& transfer() const { return *transfer_; }
 
  private:
   void collect();
+  void count_constrained();
 
   const mesh::Mesh& fluid_;
   const mesh::Mesh* solid_;
@@ -99,9 +114,11 @@ class ImmersedConstraint {
   OwnedVec fluid_work_;           ///< fluid layout, dim components
   std::vector<char> fixed_;       ///< per owned fluid vertex: a velocity condition of its own
   std::vector<int> constrained_;  ///< owned local fluid vertices
-  std::vector<double> dual_;      ///< D_i at constrained_
+  std::vector<double> dual_;      ///< D_i at constrained_ (summed over a group's solids)
+  std::vector<double> own_dual_;  ///< this solid's D_k,i at constrained_
   PetscInt n_constrained_ = 0;    ///< constrained_ summed over the ranks
   bool frozen_ = false;
+  bool shared_ = false;
 };
 
 }  // namespace coapt::coupling
