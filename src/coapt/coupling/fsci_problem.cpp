@@ -1156,6 +1156,9 @@ class FsciProblem final : public run::Problem {
     }
     const auto merged = group_->merge(shares);
     fluid_.set_velocity_constraint(merged.vertices, merged.velocities);
+    auto count = static_cast<long long>(merged.vertices.size());
+    MPI_Allreduce(MPI_IN_PLACE, &count, 1, MPI_LONG_LONG, MPI_SUM, comm_);
+    n_constrained_ = count;
   }
 
   /// λ = r/D and Bᵀλ of every solid from the fluid's constraint reactions; the balance
@@ -1337,6 +1340,9 @@ class FsciProblem final : public run::Problem {
     json["cells"] = static_cast<std::int64_t>(mesh.n_global_cells);
     json["vertices"] = static_cast<std::int64_t>(mesh.n_global_vertices);
     json["force_balance_error"] = force_balance_;
+    // each constrained fluid vertex once (a vertex several solids share counts in each of
+    // their entries below)
+    json["constrained_fluid_vertices"] = static_cast<std::int64_t>(n_constrained_);
     const char* force_unit = mesh.dim == 2 ? "N/m" : "N";
     for (const auto& solid : solids_) {
       auto& entry = json["solids"][solid->entry->name];
@@ -1493,8 +1499,9 @@ class FsciProblem final : public run::Problem {
   fluid::FluidModel fluid_;
   std::vector<std::unique_ptr<Solid>> solids_;
   std::unique_ptr<ConstraintGroup> group_;  ///< the solids' constraints together (after start)
-  double force_balance_ = 0;                ///< max over solids of the relative force balance error
-  bool deformable_ = false;                 ///< some solid is deformable: coupling iterations
+  long long n_constrained_ = 0;      ///< distinct constrained fluid vertices of the last solve
+  double force_balance_ = 0;         ///< max over solids of the relative force balance error
+  bool deformable_ = false;          ///< some solid is deformable: coupling iterations
   bool first_solve_failed_ = false;  ///< the last try failed in a solid's first solve of the step
   std::unique_ptr<InterfaceQuasiNewton> quasi_newton_;  ///< coupling.iteration.method iqn_ils
   int last_columns_ = 0;                                ///< columns of the last IQN-ILS update
