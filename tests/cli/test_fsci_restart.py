@@ -120,7 +120,7 @@ def main():
     failed = run_rigid("rigid-fails", 0.2, *blow_up, "--set", "fluid.boundary[1].waveform.values=[1,1,1e300,1e300]")
     summary = read_json(work / "rigid-fails" / "summary.json")
     runner.expect(failed.returncode == 1 and summary.get("status") == "failed"
-                  and summary.get("last_good_step") == 2 and "the last good state (step 2)" in failed.stdout,
+                  and summary.get("last_good_step") == 2 and "the last good state (step 2, t = 0.1 s)" in failed.stdout,
                   "a failed step: exit 1, summary failed, last good step 2 and where it is",
                   failed.stdout[-2000:] + failed.stderr)
     resumed = run_rigid("rigid-resumed", 0.2, *blow_up, "--set", "fluid.boundary[1].waveform.values=[1,1,1,1]",

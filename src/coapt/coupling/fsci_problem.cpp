@@ -586,15 +586,10 @@ class FsciProblem final : public run::Problem {
           // step_with_retries restored the last committed state: its figures, fields and a
           // checkpoint (to --restart from with other settings) stay in the run folder next to
           // the failure
-          output.summary()["last_good_step"] = step;
-          output.summary()["last_good_time"] = fluid_.time();
           benchmark(output);
           if (p.write_vtk && last_vtk_step != step) write_vtk(output, fluid_.time());
           write_checkpoint(output, step);
-          log::error(
-              "the step from t = {:g} s failed; the last good state (step {}) is in {}: "
-              "--restart {} continues from it",
-              fluid_.time(), step, output.directory().string(), output.directory().string());
+          output.keep_last_good_state(step, fluid_.time());
           throw;
         }
         ++step;

@@ -262,24 +262,17 @@ class FlowProblem final : public run::Problem {
   void keep_last_good_state(run::RunOutput& output, int last_step) {
     const auto& p = parameters_;
     model_.restore_step();
-    auto& summary = output.summary();
-    summary["last_good_step"] = last_step;
-    summary["last_good_time"] = model_.time();
     model_.write_windkessel_states(output);
     try {
       benchmark(output);
     } catch (const Error& error) {
       // the step's failure is what the run reports; a benchmark that cannot be evaluated on
       // the short history is recorded beside it
-      summary["benchmark_error"] = error.what();
+      output.summary()["benchmark_error"] = error.what();
     }
     if (p.write_vtk && last_vtk_step_ != last_step) model_.write_vtk(output, model_.time());
     write_checkpoint(output);
-    log::error(
-        "step {} failed; the last good state (step {}, t = {:g} s) is in {}{}: "
-        "--restart {} continues from it",
-        last_step + 1, last_step, model_.time(), output.directory().string(),
-        p.write_vtk ? " (VTK and checkpoint)" : " (checkpoint)", output.directory().string());
+    output.keep_last_good_state(last_step, model_.time());
   }
 
   /// The model's history and the benchmark histories into output/checkpoint.

@@ -91,6 +91,13 @@ void RunOutput::complete() {
   write_summary();
 }
 
+void RunOutput::keep_last_good_state(int step, double time) {
+  summary_["last_good_step"] = step;
+  summary_["last_good_time"] = time;
+  log::error("the last good state (step {}, t = {:g} s) is in {}: --restart {} continues from it",
+             step, time, directory_.string(), directory_.string());
+}
+
 void RunOutput::fail(const std::string& reason) {
   summary_["status"] = "failed";
   summary_["reason"] = reason;

@@ -47,6 +47,10 @@ class RunOutput {
   void complete();
   /// Marks the run failed with `reason` and writes the summary.
   void fail(const std::string& reason);
+  /// A step failed and the problem has written its last committed state (step `step`, at
+  /// `time` [s]) into this folder with a checkpoint: records last_good_step and
+  /// last_good_time in the summary and says in the log where it is and how to continue.
+  void keep_last_good_state(int step, double time);
   /// Whether complete() or fail() was called.
   bool finished() const { return finished_; }
 

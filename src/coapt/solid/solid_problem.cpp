@@ -400,17 +400,11 @@ class SolidProblem final : public run::Problem {
     const auto keep_last_good_state = [&](int last_step) {
       solid_.restore();
       const double last_time = last_step * time.step;
-      output.summary()["last_good_step"] = last_step;
-      output.summary()["last_good_time"] = last_time;
       const bool written =
           last_step % parameters().vtk_interval == 0 && (last_step >= first_step || !restart_);
       if (parameters().write_vtk && !written) write_vtk(output, last_time);
       checkpoint(last_step, last_time);
-      log::error(
-          "step {} failed; the last good state (step {}, t = {:g} s) is in {}: "
-          "--restart {} continues from it",
-          last_step + 1, last_step, last_time, output.directory().string(),
-          output.directory().string());
+      output.keep_last_good_state(last_step, last_time);
     };
     for (int step = first_step; step <= time.n_steps; ++step) {
       const double t = step * time.step;
