@@ -16,6 +16,10 @@ FlowProblem::keep_last_good_state).
 - No convergence: the same case with fluid.newton.max_iterations 1 (the first step needs 2)
   fails at step 1 with "no convergence in 1 iterations" and the residual history, and keeps
   the initial state (last_good_step 0, the VTK of t = 0 and a checkpoint of step 0).
+- The fluid's `reaction` field: in the straight run's VTK of every step (2 ranks), its sum over
+  the cylinder's vertices is the cylinder's force of that step's row of series.csv (c_D, c_L
+  times rho U^2 D / 2) to 1e-9 relative, and it is zero away from prescribed velocities: the
+  force written is the committed step's (FluidModel::force_level).
 """
 
 import json
@@ -42,6 +46,42 @@ def vtk_steps(r, pvd):
     bad = sum(array["non_finite"] for step in steps for kind in ("point_data", "cell_data")
               for array in step[kind])
     return [step["time"] for step in steps], bad
+
+
+def check_reactions(r, out, rows):
+    """The `reaction` field summed over the cylinder (centre (0.2, 0.2), radius 0.05) against
+    series.csv's forces of the same steps; zero at the vertices inside the channel."""
+    reader = subprocess.run(["/usr/bin/python3", str(r.source / "tools" / "vtk_read.py"),
+                             str(out / "solution.pvd")], capture_output=True, text=True)
+    if reader.returncode != 0:
+        r.expect(False, "tools/vtk_read.py reads the straight run", reader.stderr)
+        return
+    steps = json.loads(reader.stdout)["steps"]
+    r.expect(len(steps) == len(rows), "the straight run: a VTK file per step", f"{len(steps)} files")
+    scale = 2.0 / (1.0 * 1.0**2 * 0.1)  # c = 2 F / (rho U^2 D)
+    worst, stray = 0.0, 0.0
+    for step, row in zip(steps, rows):
+        points = step["points"]["values"]
+        reaction = next(a for a in step["point_data"] if a["name"] == "reaction")
+        ids = next(a for a in step["point_data"] if a["name"] == "global_id")["values"]
+        c = reaction["components"]  # vectors are written with 3 components
+        seen, force = set(), [0.0, 0.0]
+        for k in range(step["n_points"]):
+            if ids[k] in seen:  # a vertex in both ranks' pieces
+                continue
+            seen.add(ids[k])
+            x, y = points[3 * k], points[3 * k + 1]
+            f = reaction["values"][c * k:c * k + 2]
+            if math.hypot(x - 0.2, y - 0.2) <= 0.05 + 1e-9:
+                force = [force[0] + f[0], force[1] + f[1]]
+            elif 1e-9 < x < 2.2 - 1e-9 and 1e-9 < y < 0.41 - 1e-9:
+                stray = max(stray, abs(f[0]), abs(f[1]))
+        for value, column in zip(force, ("drag_coefficient", "lift_coefficient")):
+            expected = float(row[column])
+            worst = max(worst, abs(scale * value - expected) / abs(expected))
+    r.expect(worst < 1e-9 and stray == 0.0,
+             f"reaction summed over the cylinder = the step's force in series.csv (worst {worst:.1e} "
+             f"relative), zero inside the channel (largest {stray:.1e})")
 
 
 def main():
@@ -91,6 +131,7 @@ def main():
                  f"{len(restarted)} rows restarted, {len(reference)} straight")
         r.expect(read_json(straight / "summary.json")["benchmark"] == read_json(again / "summary.json")["benchmark"],
                  "restarted from the failed run: the benchmark bit for bit")
+        check_reactions(r, straight, reference)
 
     # A Newton iteration that runs out of iterations at the first step keeps the initial state.
     out = r.work / "no-convergence"

@@ -9,6 +9,8 @@
 //  - a solid clamped to a wall leaves the wall's vertices to their no-slip condition;
 //  - two solids that together cover the square (coupling::ConstraintGroup) are constrained as
 //    the square: the same vertices, a linear velocity exactly, the same total force;
+//  - FluidModel::boundary_force read after commit_step (and after a dropped trial) is the force
+//    of the committed step, with that step's own BDF history;
 //  - FluidModel::restore_step repeats a step from the same history bit for bit (state and
 //    reactions), as the coupling iterations and step retries need.
 
@@ -297,6 +299,37 @@ TEST(CouplingConstraint, RestoredStepRepeatsBitForBit) {
   EXPECT_EQ(fluid.steps(), 3);
   EXPECT_NEAR(fluid.time(), 0.15, 1e-15);
   EXPECT_GT(fluid.kinetic_energy(), 0.0);
+}
+
+TEST(CouplingConstraint, BoundaryForceAfterCommitIsTheCommittedSteps) {
+  // The flow starts from rest (the inflow switched on at t = 0), so the time derivative is a
+  // large part of the wall force in the first steps. The force read after commit_step must be
+  // the one of the step just solved: the residual with that step's history (uⁿ⁻¹, uⁿ⁻²),
+  // not with a history that already holds the committed state.
+  FluidModel fluid(read_case(), kWorld);
+  fluid.start(0.0);
+  const auto* bottom = fluid.mesh().find_group("bottom");
+  ASSERT_NE(bottom, nullptr);
+  std::vector<double> committed;
+  for (int step = 1; step <= 3; ++step) {       // BDF1, then BDF2
+    fluid.begin_step(step == 3 ? 0.03 : 0.05);  // and a changed step size
+    fluid.solve("step");
+    const auto during = fluid.boundary_force(bottom->tag);
+    fluid.commit_step();
+    committed = fluid.boundary_force(bottom->tag);
+    for (int i = 0; i < 2; ++i)
+      EXPECT_NEAR(committed[i], during[i], 1e-12 * std::abs(during[0]))
+          << "step " << step << ", component " << i;
+  }
+  EXPECT_GT(committed[0], 0.0);  // the flow drags the bottom wall downstream
+  // A trial step that is dropped leaves the committed step's force.
+  fluid.begin_step(0.05);
+  fluid.solve("step 4");
+  const auto trial = fluid.boundary_force(bottom->tag);
+  fluid.restore_step();
+  const auto restored = fluid.boundary_force(bottom->tag);
+  for (int i = 0; i < 2; ++i) EXPECT_EQ(restored[i], committed[i]) << "component " << i;
+  EXPECT_NE(trial[0], committed[0]);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <limits>
 #include <numbers>
 #include <sstream>
+#include <utility>
 
 #include "coapt/core/context.hpp"
 #include "coapt/core/error.hpp"
@@ -398,6 +399,8 @@ void FluidModel::start(double time) {
   setup_outlets();
   previous_ = fem::create_vertex_vector(mesh_, mesh_.dim + 1);
   before_ = fem::create_vertex_vector(mesh_, mesh_.dim + 1);
+  oldest_ = fem::create_vertex_vector(mesh_, mesh_.dim + 1);
+  committed_level_valid_ = false;
   time_ = committed_time_ = time;
   steps_ = 0;
   level_ = TimeLevel{};
@@ -418,6 +421,7 @@ void FluidModel::begin_step(double dt) {
   level_.alpha = bdf_weights(steps_ == 0 ? 1 : 2, dt / (steps_ == 0 ? dt : last_step_));
   level_.previous = previous_;
   level_.before_previous = before_;
+  committed_level_valid_ = false;
   time_ = committed_time_ + dt;
   write_boundary_values(time_);
   set_outlet_pressures(dt);
@@ -431,10 +435,16 @@ void FluidModel::commit_step() {
   const double dt = level_.time_step;
   for (std::size_t k = 0; k < windkessels_.size(); ++k)
     if (windkessels_[k]) windkessels_[k]->advance(fluid_->outlet_flow(k), dt);
+  COAPT_PETSC_CHECK(VecCopy(before_, oldest_));
   COAPT_PETSC_CHECK(VecCopy(previous_, before_));
   COAPT_PETSC_CHECK(VecCopy(fluid_->state(), previous_));
   fem::update_ghosts(previous_);
   fem::update_ghosts(before_);
+  fem::update_ghosts(oldest_);
+  committed_level_ = level_;
+  committed_level_.previous = before_;
+  committed_level_.before_previous = oldest_;
+  committed_level_valid_ = true;
   committed_time_ = time_;
   last_step_ = dt;
   ++steps_;
@@ -444,6 +454,8 @@ void FluidModel::restore_step() {
   COAPT_PETSC_CHECK(VecCopy(previous_, fluid_->state()));
   fem::update_ghosts(fluid_->state());
   time_ = committed_time_;
+  // the committed step's history is untouched by the dropped trial
+  committed_level_valid_ = steps_ > 0 && committed_level_.time_step > 0;
 }
 
 void FluidModel::write_checkpoint(run::CheckpointWriter& writer) const {
@@ -507,7 +519,7 @@ std::vector<double> FluidModel::constraint_reactions() {
 }
 
 std::vector<double> FluidModel::boundary_force(int tag) {
-  return fluid_->boundary_force(tag, level_);
+  return fluid_->boundary_force(tag, force_level());
 }
 
 void FluidModel::record_flows(io::CsvSeries& series) const {
@@ -683,19 +695,24 @@ void FluidModel::write_boundary_values(double time) {
 }
 
 void FluidModel::write_vtk(run::RunOutput& output, double time, const std::vector<io::Field>& extra,
-                           const std::string& name) const {
+                           const std::string& name) {
   const int dim = mesh_.dim, n = dim + 1;
-  fem::LocalValues state(fluid_->state());
+  auto reaction = fluid_->vertex_reactions(force_level());  // assembles: before the state is read
   std::vector<double> velocity(static_cast<std::size_t>(mesh_.n_vertices()) * dim),
       pressure(static_cast<std::size_t>(mesh_.n_vertices()));
-  for (int v = 0; v < mesh_.n_vertices(); ++v) {
-    for (int i = 0; i < dim; ++i)
-      velocity[static_cast<std::size_t>(v) * dim + i] = state[static_cast<std::size_t>(v) * n + i];
-    pressure[v] = state[static_cast<std::size_t>(v) * n + dim];
+  {
+    fem::LocalValues state(fluid_->state());
+    for (int v = 0; v < mesh_.n_vertices(); ++v) {
+      for (int i = 0; i < dim; ++i)
+        velocity[static_cast<std::size_t>(v) * dim + i] =
+            state[static_cast<std::size_t>(v) * n + i];
+      pressure[v] = state[static_cast<std::size_t>(v) * n + dim];
+    }
   }
   std::vector<io::Field> fields = {
       {"velocity", dim, io::Field::Location::vertex, velocity},
       {"pressure", 1, io::Field::Location::vertex, pressure},
+      {"reaction", dim, io::Field::Location::vertex, std::move(reaction)},
   };
   fields.insert(fields.end(), extra.begin(), extra.end());
   output.vtk(name).write(mesh_, time, fields);

@@ -188,7 +188,10 @@ class FluidModel {
   /// The force the fluid exerts on the constraint at each constrained vertex (same layout)
   /// at the current state [N/m in 2D, N in 3D].
   std::vector<double> constraint_reactions();
-  /// Force of the fluid on the boundary group with facet tag `tag` at the current state.
+  /// Force of the fluid on the boundary group with facet tag `tag` at the current state: the
+  /// residual of the step being solved, or, after commit_step() (and after restore_step()),
+  /// that of the committed step with its own BDF history. A state read from a checkpoint and
+  /// not stepped since is evaluated without its time derivative (uⁿ⁻² is not stored).
   std::vector<double> boundary_force(int tag);
 
   /// Outlet k's flow Q and pressure P at the current state.
@@ -203,9 +206,11 @@ class FluidModel {
   void write_windkessel_states(run::RunOutput& output) const;
   /// Kinetic energy ½ ∫ ρ |u|² of the current state (lumped P1 mass) [J/m in 2D, J].
   double kinetic_energy() const;
-  /// Velocity and pressure (and `extra` fields of this mesh) as VTK (series `name`) at `time`.
+  /// Velocity, pressure and `reaction` (the force of the fluid at each vertex whose velocity
+  /// is prescribed, NavierStokes::vertex_reactions, of the same step as boundary_force) and
+  /// `extra` fields of this mesh as VTK (series `name`) at `time`. Collective.
   void write_vtk(run::RunOutput& output, double time, const std::vector<io::Field>& extra = {},
-                 const std::string& name = "solution") const;
+                 const std::string& name = "solution");
 
  private:
   void setup_dirichlet();
@@ -213,6 +218,10 @@ class FluidModel {
   void set_outlet_pressures(double dt);
   void write_boundary_values(double time);
   std::string boundary_group_names() const;
+  /// The time level of the current state's residual: the committed step's after a commit.
+  const TimeLevel& force_level() const {
+    return committed_level_valid_ ? committed_level_ : level_;
+  }
 
   const FluidCase parameters_;
   MPI_Comm comm_;
@@ -224,7 +233,13 @@ class FluidModel {
   std::unique_ptr<NavierStokes> fluid_;
   std::vector<std::unique_ptr<lumped::Windkessel>> windkessels_;  ///< per outlet, or null
   OwnedVec previous_, before_;                                    ///< committed uⁿ, uⁿ⁻¹
+  OwnedVec oldest_;  ///< uⁿ⁻² after a commit: the committed step's own history
   TimeLevel level_;
+  /// The time level with which the committed state uⁿ was solved (its history before_ and
+  /// oldest_): forces read after commit_step() are residuals of that step, not of a step whose
+  /// history already holds uⁿ. Valid while committed_level_valid_.
+  TimeLevel committed_level_;
+  bool committed_level_valid_ = false;
   double time_ = 0, committed_time_ = 0, last_step_ = 0;
   int steps_ = 0;
 };

@@ -637,6 +637,30 @@ std::vector<double> NavierStokes::boundary_force(int tag, const TimeLevel& time)
   return force;
 }
 
+std::vector<double> NavierStokes::vertex_reactions(const TimeLevel& time) {
+  assemble_residual(time);
+  const int dim = mesh_.dim, n = dim + 1;
+  const auto fixed = all_fixed_dofs();  // sorted global dofs
+  OwnedVec reactions = fem::create_vertex_vector(mesh_, dim);
+  COAPT_PETSC_CHECK(VecSet(reactions, 0.0));
+  {
+    fem::LocalValues residual(residual_);
+    PetscScalar* values = nullptr;
+    COAPT_PETSC_CHECK(VecGetArray(reactions, &values));
+    for (int v = 0; v < mesh_.n_owned_vertices; ++v)
+      for (int i = 0; i < dim; ++i)
+        if (std::binary_search(fixed.begin(), fixed.end(),
+                               static_cast<PetscInt>(mesh_.global_vertex[v] * n + i)))
+          values[static_cast<std::size_t>(v) * dim + i] =
+              -residual[static_cast<std::size_t>(v) * n + i];
+    COAPT_PETSC_CHECK(VecRestoreArray(reactions, &values));
+  }
+  fem::update_ghosts(reactions);
+  fem::LocalValues local(reactions);
+  const auto all = local.values();
+  return {all.begin(), all.begin() + static_cast<std::ptrdiff_t>(mesh_.n_vertices()) * dim};
+}
+
 std::vector<double> NavierStokes::constraint_reactions(const TimeLevel& time) {
   assemble_residual(time);
   const int dim = mesh_.dim, n = dim + 1;

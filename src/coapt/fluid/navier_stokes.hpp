@@ -114,6 +114,11 @@ class NavierStokes {
   /// 3D], computed variationally: F_i = −R(u_h, p_h; w = e_i χ_Γ) with χ_Γ the P1 indicator of
   /// the group's vertices and R the full (stabilised) momentum residual at the current state.
   std::vector<double> boundary_force(int tag, const TimeLevel& time);
+  /// The force the fluid exerts at every local vertex whose velocity is prescribed (a velocity
+  /// or no-slip condition, or the immersed constraint), −R at its velocity dofs, and zero at
+  /// the other vertices: n_vertices() × dim values, ghosts included, for output [N/m or N].
+  /// Summed over a group's vertices it is boundary_force. Collective.
+  std::vector<double> vertex_reactions(const TimeLevel& time);
   /// Reaction forces at the constrained vertices (same order and layout as the velocities
   /// given to set_velocity_constraint): the force the fluid exerts on the constraint, −R at
   /// those velocity dofs (R = the force the constraint applies to the fluid) [N/m or N].
