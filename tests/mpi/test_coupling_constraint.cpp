@@ -13,11 +13,18 @@
 //    of the committed step, with that step's own BDF history;
 //  - FluidModel::restore_step repeats a step from the same history bit for bit (state and
 //    reactions), as the coupling iterations and step retries need.
+//  - partial coverage (ImmersedConstraint's partial_from): the partly covered nodes' weights
+//    follow their coverage and change continuously as the solid moves, their targets are
+//    averages of the solid's velocity, the force balance holds with them, and their blocking
+//    lies between the two covered-node rules they interpolate; a penalty of a very large
+//    weight gives the constraint's velocities and reactions (NavierStokes::set_velocity_penalty).
 
 #include <gtest/gtest.h>
 #include <petscvec.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <utility>
 #include <vector>
@@ -330,6 +337,148 @@ TEST(CouplingConstraint, BoundaryForceAfterCommitIsTheCommittedSteps) {
   const auto restored = fluid.boundary_force(bottom->tag);
   for (int i = 0; i < 2; ++i) EXPECT_EQ(restored[i], committed[i]) << "component " << i;
   EXPECT_NE(trial[0], committed[0]);
+}
+
+/// The effective weight s/(1 + s) of each owned fluid vertex: 1 constrained, 0 untouched.
+std::vector<double> effective_weights(const ImmersedConstraint& constraint, int n_owned) {
+  std::vector<double> weight(static_cast<std::size_t>(n_owned), 0.0);
+  for (const int v : constraint.constrained_vertices()) weight[static_cast<std::size_t>(v)] = 1.0;
+  const auto& partial = constraint.partial_vertices();
+  for (std::size_t q = 0; q < partial.size(); ++q) {
+    const double s = constraint.partial_weights()[q];
+    weight[static_cast<std::size_t>(partial[q])] = s / (1.0 + s);
+  }
+  return weight;
+}
+
+/// Drag on the square held at rest, with the covered-node rule `threshold` and partial
+/// coverage from `partial_from` (≥ threshold: none); the force balance is checked on the way.
+double square_drag(double threshold, double partial_from) {
+  FluidModel fluid(read_case(), kWorld);
+  const Mesh solid = solid_square();
+  coapt::transfer::TransferOptions options;
+  options.coverage_threshold = threshold;
+  ImmersedConstraint constraint(fluid.mesh(), solid, options, {}, partial_from);
+  fluid.start(0.0);
+  fluid.set_velocity_constraint(constraint.constrained_vertices(),
+                                constraint.transfer_uniform_velocity({0.0, 0.0}));
+  fluid.set_velocity_penalty(constraint.partial_vertices(), constraint.partial_weights(),
+                             constraint.partial_uniform_velocity({0.0, 0.0}));
+  fluid.solve_steady("immersed square");
+  const auto reactions = fluid.constraint_reactions();
+  const auto penalty = fluid.penalty_reactions();
+  auto force = constraint.create_solid_vector();
+  constraint.solid_force(constraint.multiplier(reactions), force);
+  constraint.add_partial_force(penalty, force);
+  const auto total = constraint.sum_components(force);
+  auto expected = constraint.sum_constrained(reactions);
+  const auto partial = constraint.sum_partial(penalty);
+  for (int i = 0; i < 2; ++i) {
+    expected[i] += partial[i];
+    EXPECT_NEAR(total[i], expected[i], 1e-12 * std::abs(expected[0])) << "component " << i;
+  }
+  if (partial_from < threshold) {
+    EXPECT_GT(constraint.n_partial(), 0);
+    EXPECT_GT(std::abs(partial[0]), 0.0) << "the partly covered nodes carry load";
+  }
+  return total[0];
+}
+
+TEST(CouplingConstraint, PartlyCoveredNodesFollowTheirCoverage) {
+  FluidModel fluid(read_case(), kWorld);
+  const Mesh solid = solid_square();
+  coapt::transfer::TransferOptions options;
+  options.coverage_threshold = 0.9;
+  const double from = 0.1;
+  ImmersedConstraint constraint(fluid.mesh(), solid, options, {}, from);
+  ASSERT_GT(constraint.n_partial(), 0);
+  // s/(1 + s) = (c − from)/(t − from): linear in the coverage between the two fractions
+  const PetscScalar* coverage = nullptr;
+  VecGetArrayRead(constraint.transfer().coverage(), &coverage);
+  double weight_error = 0;
+  const auto& partial = constraint.partial_vertices();
+  for (std::size_t q = 0; q < partial.size(); ++q) {
+    const double c = coverage[partial[q]], s = constraint.partial_weights()[q];
+    EXPECT_GT(c, from);
+    EXPECT_LT(c, 0.9);
+    EXPECT_GT(s, 0.0);
+    weight_error = std::max(weight_error, std::abs(s / (1 + s) - (c - from) / (0.9 - from)));
+  }
+  VecRestoreArrayRead(constraint.transfer().coverage(), &coverage);
+  MPI_Allreduce(MPI_IN_PLACE, &weight_error, 1, MPI_DOUBLE, MPI_MAX, kWorld);
+  EXPECT_LT(weight_error, 1e-9);
+  for (const int v : constraint.constrained_vertices())
+    EXPECT_FALSE(std::binary_search(partial.begin(), partial.end(), v));
+  // The targets are weighted averages of the solid's velocity: within the range of the linear
+  // field over the square, 0.3 + 1.5 x − 0.7 y ∈ [0.71, 1.59], −0.2 + 0.7 x ∈ [0.22, 0.5].
+  const auto velocity = linear_velocity(constraint, solid);
+  const auto targets = constraint.partial_velocity(velocity);
+  for (std::size_t q = 0; q < partial.size(); ++q) {
+    EXPECT_GE(targets[2 * q], 0.71 - 1e-12);
+    EXPECT_LE(targets[2 * q], 1.59 + 1e-12);
+    EXPECT_GE(targets[2 * q + 1], 0.22 - 1e-12);
+    EXPECT_LE(targets[2 * q + 1], 0.5 + 1e-12);
+  }
+  // Moving the square by h/50 changes every node's effective weight by little: no node
+  // enters or leaves the coupling with a jump (the plain covered-node rule jumps by 1).
+  const auto before = effective_weights(constraint, fluid.mesh().n_owned_vertices);
+  Mesh moved = solid;
+  for (std::size_t k = 0; k < moved.coordinates.size(); k += 2) moved.coordinates[k] += 1e-3;
+  constraint.update_solid(moved);
+  const auto after = effective_weights(constraint, fluid.mesh().n_owned_vertices);
+  double change = 0;
+  for (std::size_t v = 0; v < before.size(); ++v)
+    change = std::max(change, std::abs(after[v] - before[v]));
+  MPI_Allreduce(MPI_IN_PLACE, &change, 1, MPI_DOUBLE, MPI_MAX, kWorld);
+  EXPECT_GT(change, 0.0);
+  EXPECT_LT(change, 0.1);
+}
+
+TEST(CouplingConstraint, PartialCoverageLiesBetweenTheRulesItBlends) {
+  // The penalty's nodes are those the rule with threshold 0.1 adds to the rule with 0.9, held
+  // less firmly: the drag lies between the two rules' drags.
+  const double inner = square_drag(0.9, 1.0);
+  const double outer = square_drag(0.1, 1.0);
+  const double blended = square_drag(0.9, 0.1);
+  if (coapt::rank_of(kWorld) == 0)
+    std::printf("square drag: threshold 0.9 %.8e, 0.1 %.8e, partial 0.1-0.9 %.8e\n", inner, outer,
+                blended);
+  EXPECT_LT(inner, outer);
+  EXPECT_GT(blended, inner);
+  EXPECT_LT(blended, outer);
+}
+
+TEST(CouplingConstraint, StiffPenaltyIsTheConstraint) {
+  // The wholly covered nodes held by a penalty of weight 1e8 instead of the constraint: the
+  // same velocities (zero) and reactions up to the penalty's compliance.
+  double constrained_force = 0, penalty_force = 0, held = 0;
+  for (const bool penalty : {false, true}) {
+    FluidModel fluid(read_case(), kWorld);
+    const Mesh solid = solid_square();
+    ImmersedConstraint constraint(fluid.mesh(), solid, {});
+    fluid.start(0.0);
+    const auto& vertices = constraint.constrained_vertices();
+    const auto zero = constraint.transfer_uniform_velocity({0.0, 0.0});
+    if (penalty)
+      fluid.set_velocity_penalty(vertices, std::vector<double>(vertices.size(), 1e8), zero);
+    else
+      fluid.set_velocity_constraint(vertices, zero);
+    fluid.solve_steady("immersed square");
+    const auto reactions = penalty ? fluid.penalty_reactions() : fluid.constraint_reactions();
+    double sum = 0;
+    for (std::size_t q = 0; q < vertices.size(); ++q) sum += reactions[2 * q];
+    (penalty ? penalty_force : constrained_force) = sum_all(sum);
+    if (penalty) {
+      coapt::fem::LocalValues state(fluid.state());
+      for (const int v : vertices)
+        held = std::max({held, std::abs(state[3 * static_cast<std::size_t>(v)]),
+                         std::abs(state[3 * static_cast<std::size_t>(v) + 1])});
+      MPI_Allreduce(MPI_IN_PLACE, &held, 1, MPI_DOUBLE, MPI_MAX, kWorld);
+    }
+  }
+  EXPECT_GT(constrained_force, 0.0);
+  EXPECT_NEAR(penalty_force, constrained_force, 1e-6 * constrained_force);
+  EXPECT_LT(held, 1e-7);
 }
 
 }  // namespace

@@ -76,6 +76,7 @@ void ConstraintGroup::combine() {
         duals.push_back(total[v]);
       }
     constraints_[k]->assign(std::move(vertices), std::move(duals));
+    constraints_[k]->drop_partial(member);  // a node the group constrains is no longer partial
   }
 }
 

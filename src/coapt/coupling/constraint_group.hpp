@@ -23,6 +23,10 @@
 /// While the constraints are frozen (ImmersedConstraint::set_frozen) the constrained set is
 /// the union of their sets; a solid joins a node of it while it overlaps the node's support.
 ///
+/// Partial coverage (ImmersedConstraint's partial_from): each solid keeps its own partly
+/// covered nodes and penalty weights, less the nodes the group constrains; a node partly
+/// covered by several solids receives each one's penalty (their forces add).
+///
 ///   ConstraintGroup group(fluid_mesh, {&constraint_a, &constraint_b}, threshold, fixed);
 ///   group.combine();                            // after the solids moved
 ///   const auto merged = group.merge({a.transfer_velocity(va), b.transfer_velocity(vb)});

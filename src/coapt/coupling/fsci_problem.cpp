@@ -88,6 +88,7 @@ struct Parameters {
   fluid::FluidCase fluid;
   std::vector<SolidEntry> solids;
   transfer::TransferOptions transfer;
+  double partial_from = 1.0;  ///< coupling.partial_coverage_from (≥ the threshold: none)
   CouplingSettings coupling;
   fluid::TimeSettings time;
   Benchmark benchmark;
@@ -153,6 +154,17 @@ Parameters read(const config::Section& root) {
        "a fluid node is constrained when this fraction of its support lies in a solid "
        "(covered-node rule; 1 - 1e-10: whole support)",
        Bounds{0.0, 1.0, true, false}});
+  p.partial_from = coupling.get<double>(
+      "partial_coverage_from", 1.0,
+      {"",
+       "a fluid node not constrained whose covered fraction lies between this and "
+       "coverage_threshold is drawn towards the solid's velocity by a penalty that grows from 0 "
+       "here to the constraint at the threshold (continuous in the solid's motion; 1: none)",
+       Bounds{0.0, 1.0, true, false}});
+  if (p.partial_from < 1.0 && !(p.partial_from < p.transfer.coverage_threshold))
+    coupling.fail("partial_coverage_from",
+                  fmt::format("must lie below coverage_threshold ({:g}), got {:g}",
+                              p.transfer.coverage_threshold, p.partial_from));
   p.transfer.search_margin = coupling.get<double>(
       "search_margin", 0.0,
       {"m", "motion of a solid the transfer's search structure absorbs before a rebuild",
@@ -489,6 +501,9 @@ class FsciProblem final : public run::Problem {
     const auto& c = parameters_.coupling;
     log::info("coupling: a fluid node is constrained when {:.10g} of its support is covered",
               parameters_.transfer.coverage_threshold);
+    if (parameters_.partial_from < parameters_.transfer.coverage_threshold)
+      log::info("coupling: a node covered from {:g} on is drawn towards the solid by a penalty",
+                parameters_.partial_from);
     if (deformable_)
       log::info(
           "coupling: block Gauss-Seidel, |df| < {:g} or |df|/|f^1| < {:g}, at most {} iterations, "
@@ -530,8 +545,8 @@ class FsciProblem final : public run::Problem {
       const auto fixed = fluid_.velocity_condition_vertices();
       std::vector<ImmersedConstraint*> constraints;
       for (auto& solid : solids_) {
-        solid->constraint = std::make_unique<ImmersedConstraint>(fluid_.mesh(), solid->mesh,
-                                                                 parameters_.transfer, fixed);
+        solid->constraint = std::make_unique<ImmersedConstraint>(
+            fluid_.mesh(), solid->mesh, parameters_.transfer, fixed, parameters_.partial_from);
         constraints.push_back(solid->constraint.get());
         solid->force = solid->constraint->create_solid_vector();
         if (!solid->model) continue;
@@ -1157,6 +1172,25 @@ class FsciProblem final : public run::Problem {
     }
     const auto merged = group_->merge(shares);
     fluid_.set_velocity_constraint(merged.vertices, merged.velocities);
+    // partial coverage: each solid's penalty entries, one after the other
+    std::vector<int> vertices;
+    std::vector<double> weights, targets;
+    for (auto& solid : solids_) {
+      const auto& own = solid->constraint->partial_vertices();
+      vertices.insert(vertices.end(), own.begin(), own.end());
+      const auto& w = solid->constraint->partial_weights();
+      weights.insert(weights.end(), w.begin(), w.end());
+      std::vector<double> velocity;
+      if (solid->model && !steady) {
+        velocity = solid->constraint->partial_velocity(solid->model->velocity());
+      } else {
+        const auto& given = solid->entry->velocity;
+        velocity = solid->constraint->partial_uniform_velocity(
+            given.empty() ? std::vector<double>(static_cast<std::size_t>(dim), 0.0) : given);
+      }
+      targets.insert(targets.end(), velocity.begin(), velocity.end());
+    }
+    fluid_.set_velocity_penalty(vertices, weights, targets);
     auto count = static_cast<long long>(merged.vertices.size());
     MPI_Allreduce(MPI_IN_PLACE, &count, 1, MPI_LONG_LONG, MPI_SUM, comm_);
     n_constrained_ = count;
@@ -1167,15 +1201,25 @@ class FsciProblem final : public run::Problem {
   void compute_forces() {
     const int dim = fluid_.mesh().dim;
     const auto reactions = fluid_.constraint_reactions();
+    const auto penalty = fluid_.penalty_reactions();  // apply_constraint's order
     force_balance_ = 0;
+    std::size_t first = 0;
     for (std::size_t k = 0; k < solids_.size(); ++k) {
       auto& solid = solids_[k];
       const auto own = group_->reactions_of(k, reactions);
       const auto lambda = solid->constraint->multiplier(own);
       solid->constraint->solid_force(lambda, solid->force);
+      const std::size_t count = solid->constraint->partial_vertices().size() * dim;
+      const std::vector<double> partial(
+          penalty.begin() + static_cast<std::ptrdiff_t>(first),
+          penalty.begin() + static_cast<std::ptrdiff_t>(first + count));
+      first += count;
+      solid->constraint->add_partial_force(partial, solid->force);
       fem::update_ghosts(solid->force);
       solid->total_force = solid->constraint->sum_components(solid->force);
-      const auto total_reaction = solid->constraint->sum_constrained(own);
+      auto total_reaction = solid->constraint->sum_constrained(own);
+      const auto partial_total = solid->constraint->sum_partial(partial);
+      for (int i = 0; i < dim; ++i) total_reaction[i] += partial_total[i];
       double difference = 0, size = 0;
       for (int i = 0; i < dim; ++i) {
         difference = std::max(difference, std::abs(solid->total_force[i] - total_reaction[i]));
@@ -1289,6 +1333,8 @@ class FsciProblem final : public run::Problem {
       for (int i = 0; i < dim; ++i)
         series.add(fmt::format("force_{}_{}", axes[i], name), solid->total_force[i]);
       series.add("constrained_" + name, static_cast<double>(solid->constraint->n_constrained()));
+      if (parameters_.partial_from < parameters_.transfer.coverage_threshold)
+        series.add("partial_" + name, static_cast<double>(solid->constraint->n_partial()));
       if (!solid->model) continue;
       const auto probes = solid->model->probe_values();
       const auto& names = solid->model->parameters().probes;
@@ -1350,6 +1396,8 @@ class FsciProblem final : public run::Problem {
       entry["cells"] = static_cast<std::int64_t>(solid->mesh.n_global_cells);
       entry["constrained_fluid_vertices"] =
           static_cast<std::int64_t>(solid->constraint->n_constrained());
+      if (parameters_.partial_from < parameters_.transfer.coverage_threshold)
+        entry["partial_fluid_vertices"] = static_cast<std::int64_t>(solid->constraint->n_partial());
       entry["force"] = io::Json::array_of(solid->total_force);
       log::info("solid '{}': {} constrained fluid vertices, force ({:.8e}) {}", solid->entry->name,
                 solid->constraint->n_constrained(), fmt::join(solid->total_force, ", "),
@@ -1471,8 +1519,29 @@ class FsciProblem final : public run::Problem {
       fem::LocalValues local(marker_vector);
       for (int v = 0; v < mesh.n_vertices(); ++v) marker[v] = local[static_cast<std::size_t>(v)];
     }
-    fluid_.write_vtk(output, time,
-                     {{"constrained_by_solid", 1, io::Field::Location::vertex, marker}});
+    std::vector<io::Field> fields = {
+        {"constrained_by_solid", 1, io::Field::Location::vertex, marker}};
+    if (parameters_.partial_from < parameters_.transfer.coverage_threshold) {
+      // how firmly each node is held: 1 constrained, s/(1 + s) under the penalty, 0 free
+      COAPT_PETSC_CHECK(VecSet(marker_vector, 0.0));
+      PetscScalar* values = nullptr;
+      COAPT_PETSC_CHECK(VecGetArray(marker_vector, &values));
+      for (const auto& solid : solids_) {
+        for (const int v : solid->constraint->constrained_vertices()) values[v] = 1.0;
+        const auto& partial = solid->constraint->partial_vertices();
+        for (std::size_t q = 0; q < partial.size(); ++q) {
+          const double weight = solid->constraint->partial_weights()[q];
+          values[partial[q]] = std::min(1.0, values[partial[q]] + weight / (1.0 + weight));
+        }
+      }
+      COAPT_PETSC_CHECK(VecRestoreArray(marker_vector, &values));
+      fem::update_ghosts(marker_vector);
+      std::vector<double> held(static_cast<std::size_t>(mesh.n_vertices()));
+      fem::LocalValues local(marker_vector);
+      for (int v = 0; v < mesh.n_vertices(); ++v) held[v] = local[static_cast<std::size_t>(v)];
+      fields.push_back({"coupling_weight", 1, io::Field::Location::vertex, held});
+    }
+    fluid_.write_vtk(output, time, fields);
     for (const auto& solid : solids_) {
       const int dim = solid->mesh.dim;
       std::vector<double> force(static_cast<std::size_t>(solid->mesh.n_vertices()) * dim);

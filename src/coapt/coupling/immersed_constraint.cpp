@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 #include <mpi.h>
 
+#include <algorithm>
+
 #include "coapt/core/error.hpp"
 #include "coapt/fem/assembly.hpp"
 
@@ -10,11 +12,23 @@ namespace coapt::coupling {
 
 ImmersedConstraint::ImmersedConstraint(const mesh::Mesh& fluid, const mesh::Mesh& solid,
                                        const transfer::TransferOptions& options,
-                                       std::vector<char> fixed)
+                                       std::vector<char> fixed, double partial_from)
     : fluid_(fluid),
       solid_(&solid),
-      transfer_(std::make_unique<transfer::VariationalTransfer>(fluid, solid, options)),
-      fixed_(std::move(fixed)) {
+      transfer_(std::make_unique<transfer::VariationalTransfer>(
+          fluid, solid,
+          [&] {
+            auto with_primal = options;
+            with_primal.primal = options.primal || partial_from < options.coverage_threshold;
+            return with_primal;
+          }())),
+      fixed_(std::move(fixed)),
+      partial_from_(partial_from) {
+  if (!(partial_from > 0.0))
+    throw InputError(
+        fmt::format("immersed solid {}: the partial coverage must start above 0 "
+                    "(got {})",
+                    solid.source, partial_from));
   if (fluid.dim != solid.dim)
     throw InputError(fmt::format("immersed solid {} is {}D in a {}D fluid ({})", solid.source,
                                  solid.dim, fluid.dim, fluid.source));
@@ -69,6 +83,109 @@ void ImmersedConstraint::collect() {
   COAPT_PETSC_CHECK(VecRestoreArrayRead(transfer_->dual_mass(), &dual));
   own_dual_ = dual_;
   count_constrained();
+  collect_partial();
+}
+
+void ImmersedConstraint::collect_partial() {
+  partial_.clear();
+  partial_weight_.clear();
+  partial_integral_.clear();
+  const double threshold = transfer_->options().coverage_threshold;
+  if (partial_from_ < threshold) {
+    COAPT_PETSC_CHECK(
+        MatCreateMAIJ(transfer_->standard_coupling(), fluid_.dim, partial_coupling_.out()));
+    constexpr double largest = 1e6;  // the weight of a node as good as constrained
+    std::vector<char> member(static_cast<std::size_t>(fluid_.n_owned_vertices), 0);
+    for (const int v : constrained_) member[static_cast<std::size_t>(v)] = 1;
+    const PetscScalar *coverage = nullptr, *integral = nullptr;
+    COAPT_PETSC_CHECK(VecGetArrayRead(transfer_->coverage(), &coverage));
+    COAPT_PETSC_CHECK(VecGetArrayRead(transfer_->covered_integral(), &integral));
+    for (int v = 0; v < fluid_.n_owned_vertices; ++v) {
+      const auto index = static_cast<std::size_t>(v);
+      if (member[index] || (!fixed_.empty() && fixed_[index])) continue;
+      const double c = coverage[v];
+      if (!(c > partial_from_) || !(integral[v] > 0.0)) continue;
+      partial_.push_back(v);
+      partial_weight_.push_back(
+          c < threshold ? std::min(largest, (c - partial_from_) / (threshold - c)) : largest);
+      partial_integral_.push_back(integral[v]);
+    }
+    COAPT_PETSC_CHECK(VecRestoreArrayRead(transfer_->covered_integral(), &integral));
+    COAPT_PETSC_CHECK(VecRestoreArrayRead(transfer_->coverage(), &coverage));
+  }
+  long long count = static_cast<long long>(partial_.size());
+  MPI_Allreduce(MPI_IN_PLACE, &count, 1, MPI_LONG_LONG, MPI_SUM, fluid_.comm);
+  n_partial_ = static_cast<PetscInt>(count);
+}
+
+void ImmersedConstraint::drop_partial(const std::vector<char>& member) {
+  std::size_t kept = 0;
+  for (std::size_t q = 0; q < partial_.size(); ++q) {
+    if (member.at(static_cast<std::size_t>(partial_[q]))) continue;
+    partial_[kept] = partial_[q];
+    partial_weight_[kept] = partial_weight_[q];
+    partial_integral_[kept] = partial_integral_[q];
+    ++kept;
+  }
+  partial_.resize(kept);
+  partial_weight_.resize(kept);
+  partial_integral_.resize(kept);
+  long long count = static_cast<long long>(kept);
+  MPI_Allreduce(MPI_IN_PLACE, &count, 1, MPI_LONG_LONG, MPI_SUM, fluid_.comm);
+  n_partial_ = static_cast<PetscInt>(count);
+}
+
+std::vector<double> ImmersedConstraint::partial_velocity(Vec solid_velocity) const {
+  const int dim = fluid_.dim;
+  std::vector<double> velocities(partial_.size() * dim);
+  if (!partial_coupling_) return velocities;
+  COAPT_PETSC_CHECK(MatMult(partial_coupling_, solid_velocity, fluid_work_));
+  const PetscScalar* product = nullptr;
+  COAPT_PETSC_CHECK(VecGetArrayRead(fluid_work_, &product));
+  for (std::size_t q = 0; q < partial_.size(); ++q)
+    for (int i = 0; i < dim; ++i)
+      velocities[q * dim + i] =
+          product[static_cast<std::size_t>(partial_[q]) * dim + i] / partial_integral_[q];
+  COAPT_PETSC_CHECK(VecRestoreArrayRead(fluid_work_, &product));
+  return velocities;
+}
+
+std::vector<double> ImmersedConstraint::partial_uniform_velocity(
+    const std::vector<double>& velocity) const {
+  const auto dim = static_cast<std::size_t>(fluid_.dim);
+  if (velocity.size() != dim) throw InternalError("partial_uniform_velocity: needs dim components");
+  // the weights B^std_ij / ∫_Ω λ_i sum to 1
+  std::vector<double> velocities(partial_.size() * dim);
+  for (std::size_t q = 0; q < partial_.size(); ++q)
+    for (std::size_t i = 0; i < dim; ++i) velocities[q * dim + i] = velocity[i];
+  return velocities;
+}
+
+void ImmersedConstraint::add_partial_force(const std::vector<double>& reactions,
+                                           Vec solid_force) const {
+  const int dim = fluid_.dim;
+  if (reactions.size() != partial_.size() * dim)
+    throw InternalError("immersed constraint: reactions must be partial vertices × dim");
+  if (!partial_coupling_) return;
+  COAPT_PETSC_CHECK(VecSet(fluid_work_, 0.0));
+  PetscScalar* values = nullptr;
+  COAPT_PETSC_CHECK(VecGetArray(fluid_work_, &values));
+  for (std::size_t q = 0; q < partial_.size(); ++q)
+    for (int i = 0; i < dim; ++i)
+      values[static_cast<std::size_t>(partial_[q]) * dim + i] =
+          reactions[q * dim + i] / partial_integral_[q];
+  COAPT_PETSC_CHECK(VecRestoreArray(fluid_work_, &values));
+  COAPT_PETSC_CHECK(MatMultTransposeAdd(partial_coupling_, fluid_work_, solid_force, solid_force));
+}
+
+std::vector<double> ImmersedConstraint::sum_partial(const std::vector<double>& values) const {
+  const int dim = fluid_.dim;
+  if (values.size() != partial_.size() * dim)
+    throw InternalError("immersed constraint: values must be partial vertices × dim");
+  std::vector<double> sum(static_cast<std::size_t>(dim), 0.0);
+  for (std::size_t k = 0; k < values.size(); ++k) sum[k % dim] += values[k];
+  MPI_Allreduce(MPI_IN_PLACE, sum.data(), dim, MPI_DOUBLE, MPI_SUM, fluid_.comm);
+  return sum;
 }
 
 void ImmersedConstraint::assign(std::vector<int> vertices, std::vector<double> total_dual) {

@@ -25,6 +25,22 @@
 /// leaflet sewn to a stent): coupling::ConstraintGroup then replaces D_i by the solids' sum
 /// D_i = Σ_k D_k,i in the formulas above (assign()), so that each solid's transfer_velocity()
 /// is its share (B_k v_k)_i / D_i of the node's velocity and multiplier() the node's λ_i.
+///
+/// Partial coverage (`partial_from` < the threshold t; method/notes.md has no such rule, it is
+/// this code's regularisation of the covered-node rule). A fluid node that is not constrained
+/// but whose covered fraction c_i lies in [partial_from, t) is drawn towards the solid's
+/// velocity by a penalty of weight s_i = (c_i − partial_from)/(t − c_i) (at most 1e6; a node
+/// not constrained although c_i ≥ t, e.g. while the set is frozen, gets 1e6), which grows from
+/// 0 where the node starts to count to the constraint itself at the threshold
+/// (NavierStokes::set_velocity_penalty). Its target and its load on the solid use the standard
+/// basis, whose weights are positive on any part of a support (the dual basis's are not):
+///
+///   w_i = (B^std v_s)_i / ∫_Ω λ_i,     f_s += B^stdᵀ (r_i / ∫_Ω λ_i)   (Σ_j B^std_ij = ∫_Ω λ_i),
+///
+/// r_i the penalty's force at node i, so Σ_j (f_s)_j gains exactly Σ_i r_i and the load does
+/// the work r_i·w_i. The set and the weights change continuously as the solid moves: a node
+/// enters the penalty with weight 0 and the constraint with weight ∞, so the fluid sees a
+/// motion smaller than its elements, and the coupling's fixed-point map has no jumps.
 
 #include <petscmat.h>
 #include <petscvec.h>
@@ -49,8 +65,11 @@ class ImmersedConstraint {
   /// force. Were it constrained too, its reaction would also be the solid's load and be counted
   /// twice in the body's force (a bar clamped to a body-fitted cylinder: the pressure inside the
   /// bar on the cylinder's arc). Empty: no such vertex.
+  /// `partial_from`: the covered fraction from which a node is drawn towards the solid by a
+  /// penalty (file comment; ≥ the threshold: no partial coverage).
   ImmersedConstraint(const mesh::Mesh& fluid, const mesh::Mesh& solid,
-                     const transfer::TransferOptions& options, std::vector<char> fixed = {});
+                     const transfer::TransferOptions& options, std::vector<char> fixed = {},
+                     double partial_from = 1.0);
 
   /// The solid moved (same mesh, new coordinates): re-assembles B, D and the constrained set
   /// (while frozen: B and D only).
@@ -79,6 +98,26 @@ class ImmersedConstraint {
   /// Number of constrained fluid vertices over all ranks.
   PetscInt n_constrained() const { return n_constrained_; }
 
+  /// The partly covered vertices (owned local fluid vertices, ascending; none unless
+  /// partial_from is below the threshold) and their penalty weights s_i.
+  const std::vector<int>& partial_vertices() const { return partial_; }
+  const std::vector<double>& partial_weights() const { return partial_weight_; }
+  /// Number of partly covered vertices over all ranks.
+  PetscInt n_partial() const { return n_partial_; }
+  /// Drops the partly covered vertices that `member` (per owned fluid vertex) marks: a group's
+  /// constrained nodes (ConstraintGroup::combine).
+  void drop_partial(const std::vector<char>& member);
+  /// The penalty's targets w_i at the partly covered vertices (partial_vertices().size() × dim)
+  /// from a solid vertex vector with dim components [m/s].
+  std::vector<double> partial_velocity(Vec solid_velocity) const;
+  /// The same for a velocity that is the same vector at every solid node.
+  std::vector<double> partial_uniform_velocity(const std::vector<double>& velocity) const;
+  /// Adds B^stdᵀ (r_i / ∫_Ω λ_i) to `solid_force` from the penalty's forces r at the partly
+  /// covered vertices (same layout as partial_velocity; ghosts not updated).
+  void add_partial_force(const std::vector<double>& reactions, Vec solid_force) const;
+  /// Σ over all ranks of a partly-covered-vertex array (e.g. the penalty's total force).
+  std::vector<double> sum_partial(const std::vector<double>& values) const;
+
   /// T v_s at the constrained vertices (constrained_vertices().size() × dim, row-major) from a
   /// solid vertex vector with dim components [m/s].
   std::vector<double> transfer_velocity(Vec solid_velocity) const;
@@ -105,6 +144,7 @@ class ImmersedConstraint {
 
  private:
   void collect();
+  void collect_partial();
   void count_constrained();
 
   const mesh::Mesh& fluid_;
@@ -119,6 +159,12 @@ class ImmersedConstraint {
   PetscInt n_constrained_ = 0;    ///< constrained_ summed over the ranks
   bool frozen_ = false;
   bool shared_ = false;
+  double partial_from_ = 1.0;
+  OwnedMat partial_coupling_;             ///< B^std ⊗ I_dim (partial coverage only)
+  std::vector<int> partial_;              ///< owned local fluid vertices, partly covered
+  std::vector<double> partial_weight_;    ///< s_i at partial_
+  std::vector<double> partial_integral_;  ///< ∫_Ω λ_i at partial_
+  PetscInt n_partial_ = 0;
 };
 
 }  // namespace coapt::coupling

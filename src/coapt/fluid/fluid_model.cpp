@@ -518,6 +518,16 @@ std::vector<double> FluidModel::constraint_reactions() {
   return fluid_->constraint_reactions(level_);
 }
 
+void FluidModel::set_velocity_penalty(std::span<const int> vertices,
+                                      std::span<const double> weights,
+                                      std::span<const double> targets) {
+  fluid_->set_velocity_penalty(vertices, weights, targets);
+}
+
+std::vector<double> FluidModel::penalty_reactions() {
+  return fluid_->penalty_reactions(level_);
+}
+
 std::vector<double> FluidModel::boundary_force(int tag) {
   return fluid_->boundary_force(tag, force_level());
 }

@@ -188,6 +188,12 @@ class FluidModel {
   /// The force the fluid exerts on the constraint at each constrained vertex (same layout)
   /// at the current state [N/m in 2D, N in 3D].
   std::vector<double> constraint_reactions();
+  /// Draws the velocity at owned local vertices towards targets by a penalty of the given
+  /// weights (NavierStokes::set_velocity_penalty) for the following solves.
+  void set_velocity_penalty(std::span<const int> vertices, std::span<const double> weights,
+                            std::span<const double> targets);
+  /// The force the fluid exerts on each penalty entry (same layout) at the current state.
+  std::vector<double> penalty_reactions();
   /// Force of the fluid on the boundary group with facet tag `tag` at the current state: the
   /// residual of the step being solved, or, after commit_step() (and after restore_step()),
   /// that of the committed step with its own BDF history. A state read from a checkpoint and

@@ -269,6 +269,111 @@ void NavierStokes::set_velocity_constraint(std::span<const int> vertices,
   fem::update_ghosts(state_);
 }
 
+void NavierStokes::set_velocity_penalty(std::span<const int> vertices,
+                                        std::span<const double> weights,
+                                        std::span<const double> targets) {
+  const int dim = mesh_.dim;
+  if (weights.size() != vertices.size() ||
+      targets.size() != vertices.size() * static_cast<std::size_t>(dim))
+    throw InternalError("set_velocity_penalty: one weight and dim targets per vertex");
+  for (const int v : vertices)
+    if (v < 0 || v >= mesh_.n_owned_vertices)
+      throw InternalError("set_velocity_penalty: vertices must be owned local vertices");
+  penalty_vertices_.assign(vertices.begin(), vertices.end());
+  penalty_weights_.assign(weights.begin(), weights.end());
+  penalty_targets_.assign(targets.begin(), targets.end());
+  int active = penalty_vertices_.empty() ? 0 : 1;  // add_penalty is collective
+  MPI_Allreduce(MPI_IN_PLACE, &active, 1, MPI_INT, MPI_MAX, mesh_.comm);
+  penalty_active_ = active != 0;
+  if (penalty_vertices_.empty() || !lumped_mass_.empty()) return;
+  // ∫φ_v and ∫|∇φ_v|² of the owned vertices: every cell touching an owned vertex is local
+  // (owned or in the ghost layer).
+  lumped_mass_.assign(static_cast<std::size_t>(mesh_.n_owned_vertices), 0.0);
+  stiffness_.assign(lumped_mass_.size(), 0.0);
+  const int k = dim + 1;
+  for (int c = 0; c < mesh_.n_cells(); ++c) {
+    const auto cell = mesh_.cell(c);
+    double measure = 0;
+    double gradients[4][3] = {};
+    if (dim == 2) {
+      const double* points[3];
+      for (int a = 0; a < 3; ++a) points[a] = mesh_.point(cell[a]).data();
+      double edges[2][2], g[3][2];
+      fem::detail::edges_from_pointers<2>(points, edges);
+      measure = std::abs(fem::detail::gradients_from_edges<2>(edges, g)) / 2.0;
+      for (int a = 0; a < 3; ++a)
+        for (int i = 0; i < 2; ++i) gradients[a][i] = g[a][i];
+    } else {
+      const double* points[4];
+      for (int a = 0; a < 4; ++a) points[a] = mesh_.point(cell[a]).data();
+      double edges[3][3], g[4][3];
+      fem::detail::edges_from_pointers<3>(points, edges);
+      measure = std::abs(fem::detail::gradients_from_edges<3>(edges, g)) / 6.0;
+      for (int a = 0; a < 4; ++a)
+        for (int i = 0; i < 3; ++i) gradients[a][i] = g[a][i];
+    }
+    for (int a = 0; a < k; ++a) {
+      const int v = cell[a];
+      if (v >= mesh_.n_owned_vertices) continue;
+      double square = 0;
+      for (int i = 0; i < dim; ++i) square += gradients[a][i] * gradients[a][i];
+      lumped_mass_[static_cast<std::size_t>(v)] += measure / k;
+      stiffness_[static_cast<std::size_t>(v)] += measure * square;
+    }
+  }
+}
+
+double NavierStokes::penalty_coefficient(std::size_t k, const TimeLevel& time) const {
+  const auto v = static_cast<std::size_t>(penalty_vertices_[k]);
+  double scale = parameters_.viscosity * stiffness_[v];
+  if (time.time_step > 0)
+    scale += parameters_.density * time.alpha[0] * lumped_mass_[v] / time.time_step;
+  return penalty_weights_[k] * scale;
+}
+
+void NavierStokes::add_penalty(const TimeLevel& time, bool with_matrix) {
+  const int dim = mesh_.dim, n = dim + 1;
+  std::vector<PetscInt> dofs;
+  std::vector<PetscScalar> residuals, diagonal;
+  {
+    fem::LocalValues state(state_);
+    for (std::size_t k = 0; k < penalty_vertices_.size(); ++k) {
+      const int v = penalty_vertices_[k];
+      const double kappa = penalty_coefficient(k, time);
+      for (int i = 0; i < dim; ++i) {
+        dofs.push_back(mesh_.global_vertex[v] * n + i);
+        residuals.push_back(
+            kappa * (state[static_cast<std::size_t>(v) * n + i] - penalty_targets_[k * dim + i]));
+        diagonal.push_back(kappa);
+      }
+    }
+  }
+  COAPT_PETSC_CHECK(VecSetValues(residual_, static_cast<PetscInt>(dofs.size()), dofs.data(),
+                                 residuals.data(), ADD_VALUES));
+  COAPT_PETSC_CHECK(VecAssemblyBegin(residual_));
+  COAPT_PETSC_CHECK(VecAssemblyEnd(residual_));
+  if (!with_matrix) return;
+  for (std::size_t q = 0; q < dofs.size(); ++q)
+    COAPT_PETSC_CHECK(MatSetValue(matrix_.mat(), dofs[q], dofs[q], diagonal[q], ADD_VALUES));
+  COAPT_PETSC_CHECK(MatAssemblyBegin(matrix_.mat(), MAT_FINAL_ASSEMBLY));
+  COAPT_PETSC_CHECK(MatAssemblyEnd(matrix_.mat(), MAT_FINAL_ASSEMBLY));
+}
+
+std::vector<double> NavierStokes::penalty_reactions(const TimeLevel& time) const {
+  const int dim = mesh_.dim, n = dim + 1;
+  std::vector<double> reactions;
+  reactions.reserve(penalty_vertices_.size() * dim);
+  fem::LocalValues state(state_);
+  for (std::size_t k = 0; k < penalty_vertices_.size(); ++k) {
+    const int v = penalty_vertices_[k];
+    const double kappa = penalty_coefficient(k, time);
+    for (int i = 0; i < dim; ++i)
+      reactions.push_back(
+          kappa * (state[static_cast<std::size_t>(v) * n + i] - penalty_targets_[k * dim + i]));
+  }
+  return reactions;
+}
+
 void NavierStokes::set_outlets(const std::vector<Outlet>& outlets) {
   const int dim = mesh_.dim;
   outlets_ = outlets;
@@ -510,6 +615,7 @@ void NavierStokes::assemble(const TimeLevel& time, bool with_matrix) {
         backflow_facet_residual_and_jacobian<Dim>(facet, x, nullptr, K);
       });
     });
+  if (penalty_active_) add_penalty(time, with_matrix);
 }
 
 void NavierStokes::assemble_residual(const TimeLevel& time) {
@@ -653,6 +759,16 @@ std::vector<double> NavierStokes::vertex_reactions(const TimeLevel& time) {
                                static_cast<PetscInt>(mesh_.global_vertex[v] * n + i)))
           values[static_cast<std::size_t>(v) * dim + i] =
               -residual[static_cast<std::size_t>(v) * n + i];
+    // the penalty's vertices: its force (the residual there includes the penalty itself)
+    const auto penalty = penalty_reactions(time);
+    for (std::size_t k = 0; k < penalty_vertices_.size(); ++k) {
+      const auto v = static_cast<std::size_t>(penalty_vertices_[k]);
+      for (int i = 0; i < dim; ++i) values[v * dim + i] = 0.0;
+    }
+    for (std::size_t k = 0; k < penalty_vertices_.size(); ++k) {
+      const auto v = static_cast<std::size_t>(penalty_vertices_[k]);
+      for (int i = 0; i < dim; ++i) values[v * dim + i] += penalty[k * dim + i];
+    }
     COAPT_PETSC_CHECK(VecRestoreArray(reactions, &values));
   }
   fem::update_ghosts(reactions);

@@ -88,6 +88,20 @@ class NavierStokes {
   /// updated at those dofs; the matrix pattern stays fixed.
   void set_velocity_constraint(std::span<const int> vertices, std::span<const double> velocities);
 
+  /// Draws the velocity at owned local vertices `vertices` towards `targets` (vertices.size()
+  /// × dim, row-major) [m/s] by a penalty: R_(v,i) += κ_k (u_(v,i) − w_(k,i)) with
+  /// κ_k = weights[k] · (ρ α₀ m_v / Δt + μ g_v), m_v = ∫φ_v and g_v = ∫|∇φ_v|² (steady: the
+  /// viscous part alone), so a weight of 1 is as strong as the node's own inertia and
+  /// viscosity and a weight → ∞ tends to the constraint u = w. A vertex may appear more than
+  /// once (several solids' penalties add). Replaces the previous penalty. Not on a vertex of
+  /// the velocity constraint or a Dirichlet dof (the constraint wins there).
+  void set_velocity_penalty(std::span<const int> vertices, std::span<const double> weights,
+                            std::span<const double> targets);
+  /// The force the fluid exerts on each penalty entry (set_velocity_penalty's order and layout),
+  /// κ_k (u_v − w_k) [N/m or N]: at a converged solve, −R of the momentum equations without
+  /// the penalty, like constraint_reactions.
+  std::vector<double> penalty_reactions(const TimeLevel& time) const;
+
   /// Replaces the outlets (their facet groups must carry no Dirichlet velocity). Collective.
   void set_outlets(const std::vector<Outlet>& outlets);
   /// Sets P = resistance·Q + offset on outlet k (index into set_outlets' list) for the next
@@ -141,6 +155,10 @@ class NavierStokes {
   OwnedVec flux_vector(int tag) const;
   /// Adds Σ_k P_k(Q_k) b_k to residual_.
   void add_outlet_tractions();
+  /// Adds the velocity penalty to residual_ (and to the matrix's diagonal). Collective.
+  void add_penalty(const TimeLevel& time, bool with_matrix);
+  /// κ_k of penalty entry k for this time level.
+  double penalty_coefficient(std::size_t k, const TimeLevel& time) const;
   /// Solves (J + Σ_k R_k b̃_k b̃_kᵀ) x = rhs (b̃: b with fixed dofs zeroed) with the factorised
   /// J and the Woodbury formula; returns the Krylov iterations of all solves.
   int solve_with_outlets(Vec rhs, Vec solution, const std::vector<PetscInt>& fixed);
@@ -168,6 +186,11 @@ class NavierStokes {
   fem::LinearSolver solver_;
   std::vector<PetscInt> dirichlet_dofs_;
   std::vector<int> constrained_vertices_;
+  /// The velocity penalty: owned local vertices, weights, targets (dim each), and per owned
+  /// vertex ∫φ_v and ∫|∇φ_v|² (computed on the first penalty).
+  std::vector<int> penalty_vertices_;
+  std::vector<double> penalty_weights_, penalty_targets_, lumped_mass_, stiffness_;
+  bool penalty_active_ = false;  ///< some rank has penalty vertices
   /// Owned velocity and pressure dofs (the splits) and the assembled Schur preconditioner.
   OwnedIS velocity_dofs_, pressure_dofs_;
   OwnedMat schur_preconditioner_;

@@ -31,7 +31,7 @@ struct LocalOperators {
   std::vector<int> row_offsets;       ///< per local slave vertex + 1
   std::vector<int> columns;           ///< received master vertex (ascending within a row)
   std::vector<double> dual;           ///< ∫_Ω ψ_i φ_j
-  std::vector<double> primal;         ///< ∫_Ω λ_i φ_j (standard only)
+  std::vector<double> primal;         ///< ∫_Ω λ_i φ_j (primal or standard only)
   std::vector<double> dual_integral;  ///< per local slave vertex: ∫_Ω ψ_i (owned cells' part)
   std::vector<double> covered;        ///< ∫_Ω λ_i
   std::vector<double> full;           ///< ∫_S λ_i
@@ -45,7 +45,8 @@ class TransferEngine {
  public:
   virtual ~TransferEngine() = default;
   virtual bool update_master(const mesh::Mesh& master) = 0;
-  virtual void integrate(bool standard, LocalOperators& out) = 0;
+  /// `primal`: also ∫_Ω λ_i φ_j; `mass`: also the overlap mass blocks ∫_Ω λ_a λ_b.
+  virtual void integrate(bool primal, bool mass, LocalOperators& out) = 0;
   virtual const SearchStatistics& search_statistics() const = 0;
   virtual std::span<const PetscInt> master_vertex_global() const = 0;
 };
@@ -71,7 +72,8 @@ class Engine final : public TransferEngine {
   // the current cell, the position of that column in each of the cell's rows); at the end
   // each row is sorted by column, so the pattern does not depend on the order the pairs
   // were found in. Only entries an overlapping pair reaches are ever created.
-  void integrate(bool standard, LocalOperators& out) override {
+  void integrate(bool primal, bool mass, LocalOperators& out) override {
+    const bool standard = mass;
     constexpr int k = dim + 1;
     const mesh::Mesh& slave = search_.slave();
     const ReceivedMaster<dim>& received = search_.master();
@@ -128,7 +130,7 @@ class Engine final : public TransferEngine {
             slot[a] = static_cast<int>(r.columns.size());
             r.columns.push_back(columns[b]);
             r.dual.push_back(0.0);
-            if (standard) r.primal.push_back(0.0);
+            if (primal) r.primal.push_back(0.0);
           }
         }
       }
@@ -136,7 +138,7 @@ class Engine final : public TransferEngine {
       std::array<double*, k> dual_row, primal_row{};
       for (int a = 0; a < k; ++a) {
         dual_row[a] = row[a]->dual.data();
-        if (standard) primal_row[a] = row[a]->primal.data();
+        if (primal) primal_row[a] = row[a]->primal.data();
       }
       NodalMatrix<dim> mass_block{};
       for (std::size_t q = 0; q < n_hits; ++q) {
@@ -147,7 +149,7 @@ class Engine final : public TransferEngine {
         for (int b = 0; b < k; ++b) {
           const int* slot = slots_.data() + static_cast<std::size_t>(columns[b]) * k;
           for (int a = 0; a < k; ++a) dual_row[a][slot[a]] += dual[a][b];
-          if (standard)
+          if (primal)
             for (int a = 0; a < k; ++a) primal_row[a][slot[a]] += local.mass[a][b];
         }
         for (int a = 0; a < k; ++a) {
@@ -181,7 +183,7 @@ class Engine final : public TransferEngine {
     }
     out.columns.resize(n_entries);
     out.dual.resize(n_entries);
-    out.primal.resize(standard ? n_entries : 0);
+    out.primal.resize(primal ? n_entries : 0);
     std::vector<int> order;
     for (int r = 0; r < n_rows; ++r) {
       Row& row = rows_[static_cast<std::size_t>(r)];
@@ -193,7 +195,7 @@ class Engine final : public TransferEngine {
       for (std::size_t e = 0; e < order.size(); ++e) {
         out.columns[first + e] = row.columns[order[e]];
         out.dual[first + e] = row.dual[order[e]];
-        if (standard) out.primal[first + e] = row.primal[order[e]];
+        if (primal) out.primal[first + e] = row.primal[order[e]];
       }
       row = Row{};
     }
@@ -303,7 +305,8 @@ void VariationalTransfer::assemble() {
   const auto start = Clock::now();
   const mesh::Mesh& slave = *slave_;
   LocalOperators local;
-  engine_->integrate(options_.standard, local);
+  const bool primal = options_.standard || options_.primal;
+  engine_->integrate(primal, options_.standard, local);
   statistics_.search = engine_->search_statistics();
   statistics_.intersecting_pairs = local.intersecting_pairs;
   statistics_.intersection_seconds = local.intersection_seconds;
@@ -333,7 +336,7 @@ void VariationalTransfer::assemble() {
     mix(static_cast<std::uint64_t>(columns[e]));
   }
   int same = coupling_ && hash == pattern_hash_ && rows.size() == pattern_size_ &&
-                     (!options_.standard || standard_coupling_)
+                     (!primal || standard_coupling_)
                  ? 1
                  : 0;
   MPI_Allreduce(MPI_IN_PLACE, &same, 1, MPI_INT, MPI_MIN, slave.comm);
@@ -342,9 +345,9 @@ void VariationalTransfer::assemble() {
   pattern_size_ = rows.size();
   if (reuse) {
     assemble_matrix(coupling_, nullptr, nullptr, local.dual);
-    if (options_.standard) assemble_matrix(standard_coupling_, nullptr, nullptr, local.primal);
+    if (primal) assemble_matrix(standard_coupling_, nullptr, nullptr, local.primal);
   } else {
-    if (options_.standard) {
+    if (primal) {
       std::vector<PetscInt> i = rows, j = columns;
       assemble_matrix(standard_coupling_, &i, &j, local.primal);
     }
@@ -356,7 +359,8 @@ void VariationalTransfer::assemble() {
 
   // D, the coverage and the constrained set.
   dual_mass_ = sum_vertex_values(slave, local.dual_integral);
-  OwnedVec covered = sum_vertex_values(slave, local.covered);
+  covered_integral_ = sum_vertex_values(slave, local.covered);
+  const Vec covered = covered_integral_.get();
   OwnedVec full = sum_vertex_values(slave, local.full);
   if (!coverage_) coverage_ = layout_vector(slave.comm, slave);
   if (!work_slave_) work_slave_ = layout_vector(slave.comm, slave);

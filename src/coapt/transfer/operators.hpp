@@ -66,6 +66,9 @@ struct TransferOptions {
   double search_margin = 0.0;
   /// Also assemble the standard (primal) coupling and the overlap mass matrix.
   bool standard = false;
+  /// Also assemble the standard coupling B^std, without the overlap mass matrix (the
+  /// partial-coverage coupling, coupling::ImmersedConstraint, weighs with it).
+  bool primal = false;
 };
 
 /// What the last assembly (constructor or update_master) did on this rank.
@@ -105,6 +108,8 @@ class VariationalTransfer {
   Vec dual_mass() const { return dual_mass_.get(); }
   /// c_i = ∫_Ω λ_i / ∫_S λ_i (slave layout).
   Vec coverage() const { return coverage_.get(); }
+  /// ∫_Ω λ_i = Σ_j B^std_ij (slave layout).
+  Vec covered_integral() const { return covered_integral_.get(); }
   /// Owned global slave rows of the constrained nodes (ascending).
   const std::vector<PetscInt>& constrained_rows() const { return constrained_rows_; }
   /// The same as an IS on the slave communicator.
@@ -118,7 +123,7 @@ class VariationalTransfer {
   /// T = D⁻¹B as a matrix (rows of unconstrained nodes are zero). Collective.
   OwnedMat explicit_transfer() const;
 
-  /// B^std_ij = ∫_Ω λ_i φ_j (TransferOptions::standard only, else null).
+  /// B^std_ij = ∫_Ω λ_i φ_j (TransferOptions::standard or primal only, else null).
   Mat standard_coupling() const { return standard_coupling_.get(); }
   /// M_S,ij = ∫_Ω λ_i λ_j, 1 on the diagonal of rows without overlap (standard only).
   Mat overlap_mass() const { return overlap_mass_.get(); }
@@ -149,7 +154,7 @@ class VariationalTransfer {
       0;  ///< of B's local COO pattern (global numbers), to detect changes
   std::size_t pattern_size_ = 0;
   OwnedMat coupling_, standard_coupling_, overlap_mass_;
-  OwnedVec dual_mass_, coverage_, work_slave_;
+  OwnedVec dual_mass_, coverage_, covered_integral_, work_slave_;
   std::vector<PetscInt> constrained_rows_;
   std::vector<int> constrained_local_;  ///< owned local indices of constrained_rows_
   std::vector<double> inverse_dual_;    ///< 1 / D_i on constrained_local_
