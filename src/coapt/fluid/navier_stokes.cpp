@@ -81,6 +81,31 @@ void facet_geometry(const mesh::Mesh& mesh, int f, double* normal, double& measu
   for (int i = 0; i < dim; ++i) normal[i] = sign * direction[i] / length;
 }
 
+/// Adds ∫φ_v and ∫|∇φ_v|² over the local cells to mass[v] and stiffness[v] of each owned
+/// vertex v.
+template <int Dim>
+void add_vertex_integrals(const mesh::Mesh& mesh, std::vector<double>& mass,
+                          std::vector<double>& stiffness) {
+  constexpr int k = Dim + 1;
+  for (int c = 0; c < mesh.n_cells(); ++c) {
+    const auto cell = mesh.cell(c);
+    const double* points[k];
+    for (int a = 0; a < k; ++a) points[a] = mesh.point(cell[a]).data();
+    double edges[Dim][Dim], gradients[k][Dim];
+    fem::detail::edges_from_pointers<Dim>(points, edges);
+    const double measure = std::abs(fem::detail::gradients_from_edges<Dim>(edges, gradients)) /
+                           fem::detail::factorial(Dim);
+    for (int a = 0; a < k; ++a) {
+      const int v = cell[a];
+      if (v >= mesh.n_owned_vertices) continue;
+      double square = 0;
+      for (int i = 0; i < Dim; ++i) square += gradients[a][i] * gradients[a][i];
+      mass[static_cast<std::size_t>(v)] += measure / k;
+      stiffness[static_cast<std::size_t>(v)] += measure * square;
+    }
+  }
+}
+
 }  // namespace
 
 NavierStokes::NavierStokes(const mesh::Mesh& mesh, const FluidParameters& parameters)
@@ -290,37 +315,10 @@ void NavierStokes::set_velocity_penalty(std::span<const int> vertices,
   // (owned or in the ghost layer).
   lumped_mass_.assign(static_cast<std::size_t>(mesh_.n_owned_vertices), 0.0);
   stiffness_.assign(lumped_mass_.size(), 0.0);
-  const int k = dim + 1;
-  for (int c = 0; c < mesh_.n_cells(); ++c) {
-    const auto cell = mesh_.cell(c);
-    double measure = 0;
-    double gradients[4][3] = {};
-    if (dim == 2) {
-      const double* points[3];
-      for (int a = 0; a < 3; ++a) points[a] = mesh_.point(cell[a]).data();
-      double edges[2][2], g[3][2];
-      fem::detail::edges_from_pointers<2>(points, edges);
-      measure = std::abs(fem::detail::gradients_from_edges<2>(edges, g)) / 2.0;
-      for (int a = 0; a < 3; ++a)
-        for (int i = 0; i < 2; ++i) gradients[a][i] = g[a][i];
-    } else {
-      const double* points[4];
-      for (int a = 0; a < 4; ++a) points[a] = mesh_.point(cell[a]).data();
-      double edges[3][3], g[4][3];
-      fem::detail::edges_from_pointers<3>(points, edges);
-      measure = std::abs(fem::detail::gradients_from_edges<3>(edges, g)) / 6.0;
-      for (int a = 0; a < 4; ++a)
-        for (int i = 0; i < 3; ++i) gradients[a][i] = g[a][i];
-    }
-    for (int a = 0; a < k; ++a) {
-      const int v = cell[a];
-      if (v >= mesh_.n_owned_vertices) continue;
-      double square = 0;
-      for (int i = 0; i < dim; ++i) square += gradients[a][i] * gradients[a][i];
-      lumped_mass_[static_cast<std::size_t>(v)] += measure / k;
-      stiffness_[static_cast<std::size_t>(v)] += measure * square;
-    }
-  }
+  if (dim == 2)
+    add_vertex_integrals<2>(mesh_, lumped_mass_, stiffness_);
+  else
+    add_vertex_integrals<3>(mesh_, lumped_mass_, stiffness_);
 }
 
 double NavierStokes::penalty_coefficient(std::size_t k, const TimeLevel& time) const {
