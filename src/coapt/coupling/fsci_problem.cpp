@@ -501,7 +501,7 @@ class FsciProblem final : public run::Problem {
     const auto& c = parameters_.coupling;
     log::info("coupling: a fluid node is constrained when {:.10g} of its support is covered",
               parameters_.transfer.coverage_threshold);
-    if (parameters_.partial_from < parameters_.transfer.coverage_threshold)
+    if (partial_coverage())
       log::info("coupling: a node covered from {:g} on is drawn towards the solid by a penalty",
                 parameters_.partial_from);
     if (deformable_)
@@ -1154,6 +1154,11 @@ class FsciProblem final : public run::Problem {
     }
   }
 
+  /// coupling.partial_coverage_from is in use (below the covered-node threshold).
+  bool partial_coverage() const {
+    return parameters_.partial_from < parameters_.transfer.coverage_threshold;
+  }
+
   /// v_f = T v_s at every solid's constrained fluid nodes (steady deformable solids: v_s = 0);
   /// at a node several solids cover, the sum of their shares (ConstraintGroup: the projection
   /// from the union of the solids).
@@ -1333,7 +1338,7 @@ class FsciProblem final : public run::Problem {
       for (int i = 0; i < dim; ++i)
         series.add(fmt::format("force_{}_{}", axes[i], name), solid->total_force[i]);
       series.add("constrained_" + name, static_cast<double>(solid->constraint->n_constrained()));
-      if (parameters_.partial_from < parameters_.transfer.coverage_threshold)
+      if (partial_coverage())
         series.add("partial_" + name, static_cast<double>(solid->constraint->n_partial()));
       if (!solid->model) continue;
       const auto probes = solid->model->probe_values();
@@ -1396,7 +1401,7 @@ class FsciProblem final : public run::Problem {
       entry["cells"] = static_cast<std::int64_t>(solid->mesh.n_global_cells);
       entry["constrained_fluid_vertices"] =
           static_cast<std::int64_t>(solid->constraint->n_constrained());
-      if (parameters_.partial_from < parameters_.transfer.coverage_threshold)
+      if (partial_coverage())
         entry["partial_fluid_vertices"] = static_cast<std::int64_t>(solid->constraint->n_partial());
       entry["force"] = io::Json::array_of(solid->total_force);
       log::info("solid '{}': {} constrained fluid vertices, force ({:.8e}) {}", solid->entry->name,
@@ -1521,7 +1526,7 @@ class FsciProblem final : public run::Problem {
     }
     std::vector<io::Field> fields = {
         {"constrained_by_solid", 1, io::Field::Location::vertex, marker}};
-    if (parameters_.partial_from < parameters_.transfer.coverage_threshold) {
+    if (partial_coverage()) {
       // how firmly each node is held: 1 constrained, s/(1 + s) under the penalty, 0 free
       COAPT_PETSC_CHECK(VecSet(marker_vector, 0.0));
       PetscScalar* values = nullptr;

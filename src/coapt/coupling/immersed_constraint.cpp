@@ -9,6 +9,16 @@
 #include "coapt/fem/assembly.hpp"
 
 namespace coapt::coupling {
+namespace {
+
+/// Σ over the ranks of a local count. Collective.
+PetscInt global_count(std::size_t local, MPI_Comm comm) {
+  long long count = static_cast<long long>(local);
+  MPI_Allreduce(MPI_IN_PLACE, &count, 1, MPI_LONG_LONG, MPI_SUM, comm);
+  return static_cast<PetscInt>(count);
+}
+
+}  // namespace
 
 ImmersedConstraint::ImmersedConstraint(const mesh::Mesh& fluid, const mesh::Mesh& solid,
                                        const transfer::TransferOptions& options,
@@ -113,9 +123,7 @@ void ImmersedConstraint::collect_partial() {
     COAPT_PETSC_CHECK(VecRestoreArrayRead(transfer_->covered_integral(), &integral));
     COAPT_PETSC_CHECK(VecRestoreArrayRead(transfer_->coverage(), &coverage));
   }
-  long long count = static_cast<long long>(partial_.size());
-  MPI_Allreduce(MPI_IN_PLACE, &count, 1, MPI_LONG_LONG, MPI_SUM, fluid_.comm);
-  n_partial_ = static_cast<PetscInt>(count);
+  n_partial_ = global_count(partial_.size(), fluid_.comm);
 }
 
 void ImmersedConstraint::drop_partial(const std::vector<char>& member) {
@@ -130,24 +138,12 @@ void ImmersedConstraint::drop_partial(const std::vector<char>& member) {
   partial_.resize(kept);
   partial_weight_.resize(kept);
   partial_integral_.resize(kept);
-  long long count = static_cast<long long>(kept);
-  MPI_Allreduce(MPI_IN_PLACE, &count, 1, MPI_LONG_LONG, MPI_SUM, fluid_.comm);
-  n_partial_ = static_cast<PetscInt>(count);
+  n_partial_ = global_count(kept, fluid_.comm);
 }
 
 std::vector<double> ImmersedConstraint::partial_velocity(Vec solid_velocity) const {
-  const int dim = fluid_.dim;
-  std::vector<double> velocities(partial_.size() * dim);
-  if (!partial_coupling_) return velocities;
-  COAPT_PETSC_CHECK(MatMult(partial_coupling_, solid_velocity, fluid_work_));
-  const PetscScalar* product = nullptr;
-  COAPT_PETSC_CHECK(VecGetArrayRead(fluid_work_, &product));
-  for (std::size_t q = 0; q < partial_.size(); ++q)
-    for (int i = 0; i < dim; ++i)
-      velocities[q * dim + i] =
-          product[static_cast<std::size_t>(partial_[q]) * dim + i] / partial_integral_[q];
-  COAPT_PETSC_CHECK(VecRestoreArrayRead(fluid_work_, &product));
-  return velocities;
+  if (!partial_coupling_) return {};
+  return divided_product(partial_coupling_, solid_velocity, partial_, partial_integral_);
 }
 
 std::vector<double> ImmersedConstraint::partial_uniform_velocity(
@@ -167,15 +163,10 @@ void ImmersedConstraint::add_partial_force(const std::vector<double>& reactions,
   if (reactions.size() != partial_.size() * dim)
     throw InternalError("immersed constraint: reactions must be partial vertices × dim");
   if (!partial_coupling_) return;
-  COAPT_PETSC_CHECK(VecSet(fluid_work_, 0.0));
-  PetscScalar* values = nullptr;
-  COAPT_PETSC_CHECK(VecGetArray(fluid_work_, &values));
-  for (std::size_t q = 0; q < partial_.size(); ++q)
-    for (int i = 0; i < dim; ++i)
-      values[static_cast<std::size_t>(partial_[q]) * dim + i] =
-          reactions[q * dim + i] / partial_integral_[q];
-  COAPT_PETSC_CHECK(VecRestoreArray(fluid_work_, &values));
-  COAPT_PETSC_CHECK(MatMultTransposeAdd(partial_coupling_, fluid_work_, solid_force, solid_force));
+  std::vector<double> multiplier(reactions.size());
+  for (std::size_t k = 0; k < reactions.size(); ++k)
+    multiplier[k] = reactions[k] / partial_integral_[k / static_cast<std::size_t>(dim)];
+  transpose_product(partial_coupling_, partial_, multiplier, solid_force, true);
 }
 
 std::vector<double> ImmersedConstraint::sum_partial(const std::vector<double>& values) const {
@@ -202,23 +193,26 @@ void ImmersedConstraint::assign(std::vector<int> vertices, std::vector<double> t
 }
 
 void ImmersedConstraint::count_constrained() {
-  long long count = static_cast<long long>(constrained_.size());
-  MPI_Allreduce(MPI_IN_PLACE, &count, 1, MPI_LONG_LONG, MPI_SUM, fluid_.comm);
-  n_constrained_ = static_cast<PetscInt>(count);
+  n_constrained_ = global_count(constrained_.size(), fluid_.comm);
 }
 
 std::vector<double> ImmersedConstraint::transfer_velocity(Vec solid_velocity) const {
+  return divided_product(coupling_, solid_velocity, constrained_, dual_);
+}
+
+std::vector<double> ImmersedConstraint::divided_product(Mat coupling, Vec solid_vector,
+                                                        const std::vector<int>& vertices,
+                                                        const std::vector<double>& divisors) const {
   const int dim = fluid_.dim;
-  COAPT_PETSC_CHECK(MatMult(coupling_, solid_velocity, fluid_work_));
-  std::vector<double> velocities(constrained_.size() * dim);
+  COAPT_PETSC_CHECK(MatMult(coupling, solid_vector, fluid_work_));
+  std::vector<double> values(vertices.size() * dim);
   const PetscScalar* product = nullptr;
   COAPT_PETSC_CHECK(VecGetArrayRead(fluid_work_, &product));
-  for (std::size_t q = 0; q < constrained_.size(); ++q)
+  for (std::size_t q = 0; q < vertices.size(); ++q)
     for (int i = 0; i < dim; ++i)
-      velocities[q * dim + i] =
-          product[static_cast<std::size_t>(constrained_[q]) * dim + i] / dual_[q];
+      values[q * dim + i] = product[static_cast<std::size_t>(vertices[q]) * dim + i] / divisors[q];
   COAPT_PETSC_CHECK(VecRestoreArrayRead(fluid_work_, &product));
-  return velocities;
+  return values;
 }
 
 std::vector<double> ImmersedConstraint::transfer_uniform_velocity(
@@ -246,17 +240,26 @@ std::vector<double> ImmersedConstraint::multiplier(const std::vector<double>& re
 }
 
 void ImmersedConstraint::solid_force(const std::vector<double>& multiplier, Vec solid_force) const {
-  const int dim = fluid_.dim;
-  if (multiplier.size() != constrained_.size() * dim)
+  if (multiplier.size() != constrained_.size() * fluid_.dim)
     throw InternalError("immersed constraint: multiplier must be constrained vertices × dim");
+  transpose_product(coupling_, constrained_, multiplier, solid_force, false);
+}
+
+void ImmersedConstraint::transpose_product(Mat coupling, const std::vector<int>& vertices,
+                                           const std::vector<double>& values, Vec solid_vector,
+                                           bool add) const {
+  const int dim = fluid_.dim;
   COAPT_PETSC_CHECK(VecSet(fluid_work_, 0.0));
-  PetscScalar* values = nullptr;
-  COAPT_PETSC_CHECK(VecGetArray(fluid_work_, &values));
-  for (std::size_t q = 0; q < constrained_.size(); ++q)
+  PetscScalar* work = nullptr;
+  COAPT_PETSC_CHECK(VecGetArray(fluid_work_, &work));
+  for (std::size_t q = 0; q < vertices.size(); ++q)
     for (int i = 0; i < dim; ++i)
-      values[static_cast<std::size_t>(constrained_[q]) * dim + i] = multiplier[q * dim + i];
-  COAPT_PETSC_CHECK(VecRestoreArray(fluid_work_, &values));
-  COAPT_PETSC_CHECK(MatMultTranspose(coupling_, fluid_work_, solid_force));
+      work[static_cast<std::size_t>(vertices[q]) * dim + i] = values[q * dim + i];
+  COAPT_PETSC_CHECK(VecRestoreArray(fluid_work_, &work));
+  if (add)
+    COAPT_PETSC_CHECK(MatMultTransposeAdd(coupling, fluid_work_, solid_vector, solid_vector));
+  else
+    COAPT_PETSC_CHECK(MatMultTranspose(coupling, fluid_work_, solid_vector));
 }
 
 OwnedVec ImmersedConstraint::create_solid_vector() const {

@@ -146,6 +146,15 @@ class ImmersedConstraint {
   void collect();
   void collect_partial();
   void count_constrained();
+  /// (coupling x)_i / divisors[q] at each vertex i = vertices[q], dim components each
+  /// (row-major); x a solid vertex vector with dim components. Collective.
+  std::vector<double> divided_product(Mat coupling, Vec solid_vector,
+                                      const std::vector<int>& vertices,
+                                      const std::vector<double>& divisors) const;
+  /// couplingᵀ y with y = `values` at `vertices` (dim each, row-major) and 0 elsewhere, into
+  /// `solid_vector` (added to it when `add`). Collective.
+  void transpose_product(Mat coupling, const std::vector<int>& vertices,
+                         const std::vector<double>& values, Vec solid_vector, bool add) const;
 
   const mesh::Mesh& fluid_;
   const mesh::Mesh* solid_;

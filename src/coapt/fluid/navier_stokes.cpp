@@ -331,19 +331,14 @@ double NavierStokes::penalty_coefficient(std::size_t k, const TimeLevel& time) c
 
 void NavierStokes::add_penalty(const TimeLevel& time, bool with_matrix) {
   const int dim = mesh_.dim, n = dim + 1;
+  const std::vector<PetscScalar> residuals = penalty_reactions(time);  // κ_k (u_v − w_k)
   std::vector<PetscInt> dofs;
-  std::vector<PetscScalar> residuals, diagonal;
-  {
-    fem::LocalValues state(state_);
-    for (std::size_t k = 0; k < penalty_vertices_.size(); ++k) {
-      const int v = penalty_vertices_[k];
-      const double kappa = penalty_coefficient(k, time);
-      for (int i = 0; i < dim; ++i) {
-        dofs.push_back(mesh_.global_vertex[v] * n + i);
-        residuals.push_back(
-            kappa * (state[static_cast<std::size_t>(v) * n + i] - penalty_targets_[k * dim + i]));
-        diagonal.push_back(kappa);
-      }
+  std::vector<PetscScalar> diagonal;
+  for (std::size_t k = 0; k < penalty_vertices_.size(); ++k) {
+    const double kappa = penalty_coefficient(k, time);
+    for (int i = 0; i < dim; ++i) {
+      dofs.push_back(mesh_.global_vertex[penalty_vertices_[k]] * n + i);
+      diagonal.push_back(kappa);
     }
   }
   COAPT_PETSC_CHECK(VecSetValues(residual_, static_cast<PetscInt>(dofs.size()), dofs.data(),

@@ -45,8 +45,8 @@ class TransferEngine {
  public:
   virtual ~TransferEngine() = default;
   virtual bool update_master(const mesh::Mesh& master) = 0;
-  /// `primal`: also ∫_Ω λ_i φ_j; `mass`: also the overlap mass blocks ∫_Ω λ_a λ_b.
-  virtual void integrate(bool primal, bool mass, LocalOperators& out) = 0;
+  /// `primal`: also ∫_Ω λ_i φ_j; `overlap_mass`: also the blocks ∫_Ω λ_a λ_b.
+  virtual void integrate(bool primal, bool overlap_mass, LocalOperators& out) = 0;
   virtual const SearchStatistics& search_statistics() const = 0;
   virtual std::span<const PetscInt> master_vertex_global() const = 0;
 };
@@ -72,8 +72,7 @@ class Engine final : public TransferEngine {
   // the current cell, the position of that column in each of the cell's rows); at the end
   // each row is sorted by column, so the pattern does not depend on the order the pairs
   // were found in. Only entries an overlapping pair reaches are ever created.
-  void integrate(bool primal, bool mass, LocalOperators& out) override {
-    const bool standard = mass;
+  void integrate(bool primal, bool overlap_mass, LocalOperators& out) override {
     constexpr int k = dim + 1;
     const mesh::Mesh& slave = search_.slave();
     const ReceivedMaster<dim>& received = search_.master();
@@ -89,7 +88,7 @@ class Engine final : public TransferEngine {
     out.full.assign(static_cast<std::size_t>(n_rows), 0.0);
     out.mass_cells.clear();
     out.mass_blocks.clear();
-    workspace_.second_moment = standard;  // mass_matrix() needs it, B and D do not
+    workspace_.second_moment = overlap_mass;  // mass_matrix() needs it, B and D do not
     std::size_t n_hits = 0;  // integrals of the current cell's overlapping pairs in buffer_
 
     const auto test = [&](int, const Simplex<dim>& s, int m, unsigned& crossed) {
@@ -156,13 +155,13 @@ class Engine final : public TransferEngine {
           out.dual_integral[vertices[a]] += dual_integral[a];
           out.covered[vertices[a]] += local.integral_a[a];
         }
-        if (standard) {
+        if (overlap_mass) {
           const NodalMatrix<dim> m = mass_matrix(local.moments, s, s);
           for (int a = 0; a < k; ++a)
             for (int b = 0; b < k; ++b) mass_block[a][b] += m[a][b];
         }
       }
-      if (standard) {
+      if (overlap_mass) {
         out.mass_cells.push_back(c);
         for (int a = 0; a < k; ++a)
           for (int b = 0; b < k; ++b) out.mass_blocks.push_back(mass_block[a][b]);
