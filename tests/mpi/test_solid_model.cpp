@@ -4,7 +4,8 @@
 // to zero (an immersed solid as dense as the fluid) steps quasi-statically, the iteration
 // inertia (set_iteration_density) cancels at the fixed point of the iteration that loads the
 // solid with its iteration_force(), and a driver's options (SolidModelOptions) make a case
-// without time keys dynamic and refine its mesh.
+// without time keys dynamic and refine its mesh; a uniform immersed pressure loads it as the
+// follower pressure on its boundary.
 
 #include <gtest/gtest.h>
 #include <petscvec.h>
@@ -97,6 +98,49 @@ TEST(SolidModel, ExtraForceActsLikeTheLoadItStandsFor) {
   const double scale = max_norm(reference.displacement());
   EXPECT_GT(scale, 1e-4);
   EXPECT_LT(max_difference(reference.displacement(), solid.displacement()), 1e-10 * scale);
+}
+
+// The fluid's pressure an immersed solid carries (set_immersed_pressure), −∫ p div_x w over
+// the current configuration: for a uniform p it is, cell by cell, the follower pressure −p n
+// on the boundary, so the strip loaded by it must deform as the strip with `pressures:` on
+// its free sides (the clamped side's load goes into the reaction). The load is large (5 % of
+// E, a visible geometric nonlinearity) and Newton converges as fast with it as with the
+// follower pressure (the tangent is exact), and a zero field changes nothing.
+TEST(SolidModel, UniformImmersedPressureIsTheFollowerPressureOnItsBoundary) {
+  Output output("immersed_pressure");
+  constexpr double pressure = 5.0e4;
+  const std::string neo_hookean =
+      "    material: {model: neo_hookean, young_modulus: 1.0e6, poisson_ratio: 0.3}\n";
+  auto with_material = [&](std::string text) {
+    const auto at = text.find("    material:");
+    const auto end = text.find('\n', at);
+    return text.replace(at, end - at + 1, neo_hookean);
+  };
+  auto loaded =
+      Document::from_string(with_material(strip_case("pressures:\n"
+                                                     "  - {boundary: right, pressure: 5.0e4}\n"
+                                                     "  - {boundary: top, pressure: 5.0e4}\n"
+                                                     "  - {boundary: bottom, pressure: 5.0e4}\n")),
+                            "follower.yaml");
+  SolidModel reference(loaded.root(), kWorld);
+  const auto follower = reference.solve_static(1.0, output.output, "follower", false);
+
+  auto unloaded = Document::from_string(with_material(strip_case("")), "immersed.yaml");
+  SolidModel solid(unloaded.root(), kWorld);
+  OwnedVec field = coapt::fem::create_vertex_vector(solid.mesh(), 1);
+  VecSet(field, 0.0);
+  coapt::fem::update_ghosts(field);
+  solid.set_immersed_pressure(field);
+  solid.solve_static(1.0, output.output, "zero", false);
+  EXPECT_EQ(max_norm(solid.displacement()), 0.0);
+
+  VecSet(field, pressure);
+  coapt::fem::update_ghosts(field);
+  const auto immersed = solid.solve_static(1.0, output.output, "immersed", false);
+  const double scale = max_norm(reference.displacement());
+  EXPECT_GT(scale, 1e-3);  // the strip shortens by about (1 + ν)(1 − 2ν) p/E
+  EXPECT_LT(max_difference(reference.displacement(), solid.displacement()), 1e-9 * scale);
+  EXPECT_LE(immersed.newton_iterations, follower.newton_iterations + 1);
 }
 
 TEST(SolidModel, RepeatedStepFromTheCommittedStateIsIdentical) {

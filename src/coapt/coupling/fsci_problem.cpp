@@ -88,7 +88,8 @@ struct Parameters {
   fluid::FluidCase fluid;
   std::vector<SolidEntry> solids;
   transfer::TransferOptions transfer;
-  double partial_from = 1.0;  ///< coupling.partial_coverage_from (≥ the threshold: none)
+  double partial_from = 1.0;       ///< coupling.partial_coverage_from (≥ the threshold: none)
+  bool pressure_in_solid = false;  ///< coupling.pressure_in_solid (ImmersedConstraint)
   CouplingSettings coupling;
   fluid::TimeSettings time;
   Benchmark benchmark;
@@ -165,6 +166,13 @@ Parameters read(const config::Section& root) {
     coupling.fail("partial_coverage_from",
                   fmt::format("must lie below coverage_threshold ({:g}), got {:g}",
                               p.transfer.coverage_threshold, p.partial_from));
+  p.pressure_in_solid = coupling.get<bool>(
+      "pressure_in_solid", false,
+      {"",
+       "load each deformable solid also with the fluid's pressure over its region, -int p div w: "
+       "the solid then carries sigma_s + p I, as it carries rho_s - rho_f, so that a compressible "
+       "solid is squeezed by the pressure's level and not only pushed by its gradient (false: the "
+       "method as published)"});
   p.transfer.search_margin = coupling.get<double>(
       "search_margin", 0.0,
       {"m", "motion of a solid the transfer's search structure absorbs before a rebuild",
@@ -354,6 +362,9 @@ struct Solid {
   /// deformable: the load the last iterate asks for, force + the solid's iteration inertia
   /// (the force alone without coupling.iteration.iteration_density), and that inertia
   OwnedVec target, iteration_force;
+  /// deformable, coupling.pressure_in_solid: the fluid's pressure the solid carries (one
+  /// component per solid vertex, from the last fluid solve) and its value at the step's start
+  OwnedVec pressure, pressure_start;
 
   /// Deformable: the model's current configuration into the mesh and the transfer (the
   /// constrained set is recomputed unless frozen). Collective.
@@ -504,6 +515,9 @@ class FsciProblem final : public run::Problem {
     if (partial_coverage())
       log::info("coupling: a node covered from {:g} on is drawn towards the solid by a penalty",
                 parameters_.partial_from);
+    if (parameters_.pressure_in_solid && deformable_)
+      log::info(
+          "coupling: the deformable solids also carry the fluid's pressure over their region");
     if (deformable_)
       log::info(
           "coupling: block Gauss-Seidel, |df| < {:g} or |df|/|f^1| < {:g}, at most {} iterations, "
@@ -545,8 +559,10 @@ class FsciProblem final : public run::Problem {
       const auto fixed = fluid_.velocity_condition_vertices();
       std::vector<ImmersedConstraint*> constraints;
       for (auto& solid : solids_) {
+        auto options = parameters_.transfer;
+        options.primal = options.primal || (parameters_.pressure_in_solid && solid->model);
         solid->constraint = std::make_unique<ImmersedConstraint>(
-            fluid_.mesh(), solid->mesh, parameters_.transfer, fixed, parameters_.partial_from);
+            fluid_.mesh(), solid->mesh, options, fixed, parameters_.partial_from);
         constraints.push_back(solid->constraint.get());
         solid->force = solid->constraint->create_solid_vector();
         if (!solid->model) continue;
@@ -557,6 +573,13 @@ class FsciProblem final : public run::Problem {
           COAPT_PETSC_CHECK(VecSet(*v, 0.0));
         }
         solid->model->set_external_force(solid->applied);
+        if (parameters_.pressure_in_solid) {
+          for (auto* v : {&solid->pressure, &solid->pressure_start}) {
+            *v = fem::create_vertex_vector(solid->mesh, 1);
+            COAPT_PETSC_CHECK(VecSet(*v, 0.0));
+          }
+          solid->model->set_immersed_pressure(solid->pressure);
+        }
       }
       group_ = std::make_unique<ConstraintGroup>(fluid_.mesh(), constraints,
                                                  parameters_.transfer.coverage_threshold, fixed);
@@ -651,9 +674,9 @@ class FsciProblem final : public run::Problem {
   /// The coupled state after `step` committed steps into output/checkpoint: the fluid's BDF
   /// history and Windkessels (FluidModel::write_checkpoint); per solid k (fields solid<k>_...)
   /// its constrained fluid nodes and frozen flag, its force Bᵀλ, and for a deformable solid
-  /// the committed Newmark state, the applied (relaxed) force that starts the next step and
-  /// the contact state, for a rigid one its coordinates; the IQN-ILS columns kept for reuse;
-  /// the valve history.
+  /// the committed Newmark state, the applied (relaxed) force that starts the next step, the
+  /// fluid's pressure it carries (coupling.pressure_in_solid) and the contact state, for a rigid
+  /// one its coordinates; the IQN-ILS columns kept for reuse; the valve history.
   void write_checkpoint(run::RunOutput& output, int step) const {
     run::CheckpointWriter writer(comm_, output.directory() / "checkpoint");
     auto& state = writer.state();
@@ -682,6 +705,8 @@ class FsciProblem final : public run::Problem {
       if (solid.model) {
         solid.model->write_checkpoint(writer, prefix);
         writer.add_vertex_field(prefix + "applied", solid.mesh, solid.applied, dim);
+        if (solid.pressure)
+          writer.add_vertex_field(prefix + "pressure", solid.mesh, solid.pressure, 1);
         if (solid.contact) solid.contact->write_checkpoint(writer, prefix);
       } else {
         auto coordinates = fem::create_vertex_vector(solid.mesh, dim);
@@ -735,6 +760,10 @@ class FsciProblem final : public run::Problem {
       if (solid.model) {
         // the applied force first: the contact-stabilized scheme's committed residual uses it
         reader.read_vertex_field(prefix + "applied", solid.mesh, solid.applied, dim);
+        if (solid.pressure) {
+          reader.read_vertex_field(prefix + "pressure", solid.mesh, solid.pressure, 1);
+          fem::update_ghosts(solid.pressure);
+        }
         solid.model->read_checkpoint(reader, prefix);
         if (solid.contact) solid.contact->read_checkpoint(reader, prefix);
         solid.mesh.coordinates = solid.model->current_coordinates();
@@ -938,6 +967,10 @@ class FsciProblem final : public run::Problem {
         if (solid.model) {
           solid.model->restore();
           COAPT_PETSC_CHECK(VecCopy(solid.applied_start, solid.applied));
+          if (solid.pressure) {
+            COAPT_PETSC_CHECK(VecCopy(solid.pressure_start, solid.pressure));
+            fem::update_ghosts(solid.pressure);
+          }
         } else if (solid.mesh.coordinates != committed_coordinates[k]) {
           solid.mesh.coordinates = committed_coordinates[k];
           solid.constraint->update_solid(solid.mesh);
@@ -962,8 +995,10 @@ class FsciProblem final : public run::Problem {
       ScopedTimer timer(output.timers(), "transfer");
       move_rigid_solids(dt);
     }
-    for (auto& solid : solids_)
+    for (auto& solid : solids_) {
       if (solid->model) COAPT_PETSC_CHECK(VecCopy(solid->applied, solid->applied_start));
+      if (solid->pressure) COAPT_PETSC_CHECK(VecCopy(solid->pressure, solid->pressure_start));
+    }
     if (quasi_newton_) quasi_newton_->begin_step();
     for (auto& solid : solids_) {
       solid->constraint->set_frozen(false);
@@ -1221,6 +1256,11 @@ class FsciProblem final : public run::Problem {
       first += count;
       solid->constraint->add_partial_force(partial, solid->force);
       fem::update_ghosts(solid->force);
+      if (solid->pressure) {
+        const auto pressure = solid->constraint->solid_pressure(fluid_.state());
+        COAPT_PETSC_CHECK(VecCopy(pressure, solid->pressure));
+        fem::update_ghosts(solid->pressure);
+      }
       solid->total_force = solid->constraint->sum_components(solid->force);
       auto total_reaction = solid->constraint->sum_constrained(own);
       const auto partial_total = solid->constraint->sum_partial(partial);

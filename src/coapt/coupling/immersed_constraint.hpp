@@ -41,6 +41,17 @@
 /// the work r_i·w_i. The set and the weights change continuously as the solid moves: a node
 /// enters the penalty with weight 0 and the constraint with weight ∞, so the fluid sees a
 /// motion smaller than its elements, and the coupling's fixed-point map has no jumps.
+///
+/// The pressure inside a solid (`coupling.pressure_in_solid`; not in method/paper.md, this
+/// code's addition). Over the solid's region the fluid is fictitious; at rest it carries the
+/// stress −p I, and the solid, loaded by λ, feels only the pressure's gradient, never its
+/// level: a body-fitted compressible solid is squeezed by the pressure around it, an immersed
+/// one is not. As the solid carries ρ_s − ρ_f so that the two densities add up to the real one,
+/// it can carry σ_s + p I so that the two stresses add up to the real σ_s: the load
+/// −∫_Ω_s p div w (solid::SolidModel::set_immersed_pressure), with the pressure on the solid's
+/// vertices from solid_pressure(): p_j = (B^stdᵀ p_f)_j / Σ_i B^std_ij, the fluid's pressure
+/// averaged over the support of φ_j. The load has no resultant (Σ_j ∇φ_j = 0), so drag, lift
+/// and the force balance keep their values; under a uniform p it is the surface load −p n.
 
 #include <petscmat.h>
 #include <petscvec.h>
@@ -117,6 +128,12 @@ class ImmersedConstraint {
   void add_partial_force(const std::vector<double>& reactions, Vec solid_force) const;
   /// Σ over all ranks of a partly-covered-vertex array (e.g. the penalty's total force).
   std::vector<double> sum_partial(const std::vector<double>& values) const;
+
+  /// The fluid's pressure on the solid's vertices, p_j = (B^stdᵀ p_f)_j / Σ_i B^std_ij (0 at
+  /// a vertex whose support the fluid mesh does not reach), from the fluid's state (u, p
+  /// interleaved, `fluid.dim + 1` components). A ghosted solid vertex vector, one component
+  /// [Pa]. Needs TransferOptions::primal. Collective.
+  OwnedVec solid_pressure(Vec fluid_state) const;
 
   /// T v_s at the constrained vertices (constrained_vertices().size() × dim, row-major) from a
   /// solid vertex vector with dim components [m/s].

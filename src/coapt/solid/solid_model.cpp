@@ -208,6 +208,13 @@ class SolidModelImpl {
   Vec velocity() const { return v_.get(); }
   Vec acceleration() const { return a_.get(); }
   void set_external_force(Vec force) { extra_force_ = force; }
+  void set_immersed_pressure(Vec pressure) {
+    if (pressure && parameters_.mixed)
+      throw InputError(
+          "solid: formulation: mixed cannot carry the fluid's pressure "
+          "(coupling.pressure_in_solid) yet: use formulation: displacement");
+    immersed_pressure_ = pressure;
+  }
   void set_hook(NewtonHook* hook) {
     if (hook && parameters_.mixed)
       throw InputError(
@@ -1331,6 +1338,39 @@ class SolidModelImpl {
     }
   }
 
+  /// The fluid's pressure the solid carries (set_immersed_pressure), p̄ the mean of cell c's
+  /// nodal values: adds |T| p̄ h_ai = ∫ p div_x N_a (h_a = F⁻ᵀ ∇N_a = ∇_x N_a, |T| = J |T₀|)
+  /// to its element vector (`matrix` false), or its derivative |T| p̄ (h_ai h_bk − h_bi h_ak)
+  /// to its element matrix (`matrix` true), node-major.
+  template <int Dim>
+  void add_immersed_pressure(int c, const NodalValues<Dim>& displacement,
+                             const fem::LocalValues& pressure, bool matrix, double* element) const {
+    const auto vertices = mesh_.cell(c);
+    double mean = 0;
+    for (int a = 0; a <= Dim; ++a) mean += pressure[static_cast<std::size_t>(vertices[a])];
+    mean /= Dim + 1;
+    if (mean == 0.0) return;
+    const auto g = geometry<Dim>(c);
+    const MatrixD<Dim> F = deformation_gradient<Dim>(g.gradients, displacement);
+    const double J = F.determinant();
+    // row a: (F⁻ᵀ ∇N_a)ᵀ = ∇_x N_a, the spatial gradient
+    const NodalValues<Dim> h = g.gradients * F.inverse();
+    const double scale = g.measure * mean * J;  // |T| p̄ with |T| = J |T₀|
+    constexpr int n = (Dim + 1) * Dim;
+    if (!matrix) {
+      for (int a = 0; a <= Dim; ++a)
+        for (int i = 0; i < Dim; ++i) element[a * Dim + i] += scale * h(a, i);
+      return;
+    }
+    // ∂(J F⁻ᵀ)_iJ/∂F_kL = J (F⁻ᵀ_iJ F⁻ᵀ_kL − F⁻ᵀ_iL F⁻ᵀ_kJ), contracted with ∇N_a and ∇N_b
+    for (int a = 0; a <= Dim; ++a)
+      for (int i = 0; i < Dim; ++i)
+        for (int b = 0; b <= Dim; ++b)
+          for (int k = 0; k < Dim; ++k)
+            element[(a * Dim + i) * n + b * Dim + k] +=
+                scale * (h(a, i) * h(b, k) - h(b, i) * h(a, k));
+  }
+
   /// R = f_int(u) − s f_ext − f_extra (+ M a when `inertia` holds M a) + the hook's terms into
   /// residual_ with the Dirichlet rows zeroed; returns ‖R‖₂, or +∞ when some cell is inverted
   /// (det F ≤ 0 or not finite) on any rank. Collective.
@@ -1345,6 +1385,8 @@ class SolidModelImpl {
     double min_J = std::numeric_limits<double>::infinity();
     {
       fem::LocalValues values(u);
+      std::optional<fem::LocalValues> immersed;
+      if (immersed_pressure_) immersed.emplace(immersed_pressure_);
       fem::assemble_vector(mesh_, Dim, residual_, [&](int c, double* element) {
         const auto g = geometry<Dim>(c);
         const NodalValues<Dim> displacement = nodal<Dim>(values, c);
@@ -1354,6 +1396,7 @@ class SolidModelImpl {
         const auto r = element_residual<Dim>(g, body(c).material, fibres(c), displacement);
         std::copy(r.data(), r.data() + r.size(), element);
         add_pressure<Dim>(c, displacement, factor, false, element);
+        if (immersed) add_immersed_pressure<Dim>(c, displacement, *immersed, false, element);
       });
     }
     MPI_Allreduce(MPI_IN_PLACE, &min_J, 1, MPI_DOUBLE, MPI_MIN, comm_);
@@ -1379,12 +1422,15 @@ class SolidModelImpl {
   template <int Dim>
   void assemble_tangent(Vec u, double mass_factor) {
     fem::LocalValues values(u);
+    std::optional<fem::LocalValues> immersed;
+    if (immersed_pressure_) immersed.emplace(immersed_pressure_);
     matrix_.assemble([&](int c, double* element) {
       const NodalValues<Dim> displacement = nodal<Dim>(values, c);
       const auto K =
           element_tangent<Dim>(geometry<Dim>(c), body(c).material, fibres(c), displacement);
       std::copy(K.data(), K.data() + K.size(), element);
       add_pressure<Dim>(c, displacement, pressure_factor_, true, element);
+      if (immersed) add_immersed_pressure<Dim>(c, displacement, *immersed, true, element);
       if (mass_factor != 0) add_element_mass(c, mass_factor, element);
       if (mass_factor != 0 && iteration_density_ > 0)
         add_lumped_mass<Dim>(c, mass_factor * iteration_density_, element);
@@ -1694,8 +1740,9 @@ class SolidModelImpl {
   std::optional<fem::P1Matrix> mass_;  ///< inertia-density mass (dynamics only)
   OwnedVec lumped_mass_;               ///< its diagonal (contact-stabilized predictor)
   fem::LinearSolver solver_;
-  Vec extra_force_ = nullptr;   ///< not owned
-  NewtonHook* hook_ = nullptr;  ///< not owned
+  Vec extra_force_ = nullptr;        ///< not owned
+  Vec immersed_pressure_ = nullptr;  ///< not owned: the fluid's pressure it carries [Pa]
+  NewtonHook* hook_ = nullptr;       ///< not owned
   double density_offset_ = 0;
   // set_iteration_density: the density, its lumped mass m_a, u_p of the step, 4/Δt², and
   // 4/Δt² m_a (u − u_p) of the last residual
@@ -1747,6 +1794,9 @@ void SolidModel::set_external_force(Vec force) {
 }
 void SolidModel::set_hook(NewtonHook* hook) {
   impl_->set_hook(hook);
+}
+void SolidModel::set_immersed_pressure(Vec pressure) {
+  impl_->set_immersed_pressure(pressure);
 }
 void SolidModel::set_iteration_density(double density) {
   impl_->set_iteration_density(density);

@@ -12,10 +12,12 @@
 ///    extra force, the same step) until commit() accepts the trial state; restore() returns the
 ///    trial state to the committed one.
 ///
-/// Two ways to act on the solid from outside:
+/// Three ways to act on the solid from outside:
 ///  - set_external_force(f): an extra nodal force vector f_extra (a vertex vector of this
 ///    mesh, node-major, dim components) in every residual, not ramped with the load factor
 ///    (the transferred fluid force of the immersed coupling);
+///  - set_immersed_pressure(p): a pressure field over the solid whose load −∫ p div_x w
+///    follows its deformation (the fluid's pressure a compressible immersed solid carries);
 ///  - set_hook(h): a NewtonHook whose terms enter every Newton iteration (contact).
 ///
 /// Immersed solids carry the density ρ_body − ρ_offset in their inertia (set_density_offset;
@@ -152,6 +154,13 @@ class SolidModel {
   /// An extra nodal force in every residual (null: none). The vector must live until it is
   /// replaced; only its owned entries are read.
   void set_external_force(Vec force);
+  /// The immersed coupling's fluid pressure over the solid (null: none;
+  /// coupling.pressure_in_solid): a ghosted vertex vector of this mesh with one component [Pa], p
+  /// at each vertex, which enters every residual as the load −∫ p div_x w over the current
+  /// configuration (a follower load with its exact tangent; no resultant; under a uniform p the
+  /// surface load −p n). Not owned; it must live until replaced. Not with formulation: mixed
+  /// (InputError).
+  void set_immersed_pressure(Vec pressure);
   /// The Newton hook (null: none). Not owned.
   void set_hook(NewtonHook* hook);
   /// Inertia uses the density ρ_body − offset [kg/m³] (≥ 0 for every body, else InputError).
