@@ -52,6 +52,11 @@ def main():
                        ["check", cases / "turek_hron" / "fsi1.yaml",
                         "--set", "coupling.iteration.iteration_density=1000"],
                        ["coupling.iteration.iteration_density", "transient"])
+    expect_input_error("the fluid's pressure in a solid of the mixed formulation",
+                       ["run", cases / "turek_hron" / "fsi1.yaml", "--output", work / "o4",
+                        "--set", "solids[0].formulation=mixed", "--set",
+                        "solids[0].bodies[0].material.model=nearly_incompressible_neo_hookean"],
+                       ["fsi1.yaml:28", "solid 'bar'", "coupling.pressure_in_solid", "mixed"])
     unknown_problem = write(work / "unknown_problem.yaml", "problem: poison\n")
     expect_input_error("unknown problem", ["check", unknown_problem], ["unknown_problem.yaml:1", "problem", "poison"])
 

@@ -578,7 +578,12 @@ class FsciProblem final : public run::Problem {
             *v = fem::create_vertex_vector(solid->mesh, 1);
             COAPT_PETSC_CHECK(VecSet(*v, 0.0));
           }
-          solid->model->set_immersed_pressure(solid->pressure);
+          try {
+            solid->model->set_immersed_pressure(solid->pressure);
+          } catch (const InputError& error) {
+            throw InputError(fmt::format("{}: solid '{}': {}", solid->entry->where,
+                                         solid->entry->name, error.what()));
+          }
         }
       }
       group_ = std::make_unique<ConstraintGroup>(fluid_.mesh(), constraints,

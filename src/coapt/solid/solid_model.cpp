@@ -703,12 +703,14 @@ class SolidModelImpl {
     return result;
   }
 
-  /// Σ of f_int(u) (with the follower pressures at the last load factor) over the owned
-  /// vertices of a boundary group. Collective.
+  /// Σ of f_int(u) (with the follower pressures at the last load factor and the immersed
+  /// pressure) over the owned vertices of a boundary group. Collective.
   std::vector<double> reaction_force(const std::string& boundary) const {
     const int tag = facet_tag(boundary, "reaction_force");
     auto force = fem::create_vertex_vector(mesh_, dim_);
     fem::LocalValues values(u_.get());
+    std::optional<fem::LocalValues> immersed;
+    if (immersed_pressure_) immersed.emplace(immersed_pressure_);
     const auto element_forces = [&](auto dimension, int c, double* element) {
       constexpr int Dim = decltype(dimension)::value;
       const NodalValues<Dim> displacement = nodal<Dim>(values, c);
@@ -716,6 +718,7 @@ class SolidModelImpl {
           element_residual<Dim>(geometry<Dim>(c), body(c).material, fibres(c), displacement);
       std::copy(r.data(), r.data() + r.size(), element);
       add_pressure<Dim>(c, displacement, pressure_factor_, false, element);
+      if (immersed) add_immersed_pressure<Dim>(c, displacement, *immersed, false, element);
     };
     fem::assemble_vector(mesh_, dim_, force, [&](int c, double* element) {
       if (dim_ == 2)
