@@ -1261,11 +1261,7 @@ class FsciProblem final : public run::Problem {
       first += count;
       solid->constraint->add_partial_force(partial, solid->force);
       fem::update_ghosts(solid->force);
-      if (solid->pressure) {
-        const auto pressure = solid->constraint->solid_pressure(fluid_.state());
-        COAPT_PETSC_CHECK(VecCopy(pressure, solid->pressure));
-        fem::update_ghosts(solid->pressure);
-      }
+      if (solid->pressure) solid->constraint->solid_pressure(fluid_.state(), solid->pressure);
       solid->total_force = solid->constraint->sum_components(solid->force);
       auto total_reaction = solid->constraint->sum_constrained(own);
       const auto partial_total = solid->constraint->sum_partial(partial);

@@ -279,7 +279,7 @@ std::vector<double> ImmersedConstraint::sum_components(Vec solid_vector) const {
   return sum;
 }
 
-OwnedVec ImmersedConstraint::solid_pressure(Vec fluid_state) const {
+void ImmersedConstraint::solid_pressure(Vec fluid_state, Vec pressure) const {
   const Mat coupling = transfer_->standard_coupling();
   if (!coupling) throw InternalError("solid_pressure: the transfer has no standard coupling");
   OwnedVec on_solid, weight, on_fluid;
@@ -288,32 +288,30 @@ OwnedVec ImmersedConstraint::solid_pressure(Vec fluid_state) const {
   {
     const int n = fluid_.dim + 1;
     const PetscScalar* state = nullptr;
-    PetscScalar* pressure = nullptr;
+    PetscScalar* values = nullptr;
     COAPT_PETSC_CHECK(VecGetArrayRead(fluid_state, &state));
-    COAPT_PETSC_CHECK(VecGetArray(on_fluid, &pressure));
+    COAPT_PETSC_CHECK(VecGetArray(on_fluid, &values));
     for (int v = 0; v < fluid_.n_owned_vertices; ++v)
-      pressure[v] = state[static_cast<std::size_t>(v) * n + fluid_.dim];
-    COAPT_PETSC_CHECK(VecRestoreArray(on_fluid, &pressure));
+      values[v] = state[static_cast<std::size_t>(v) * n + fluid_.dim];
+    COAPT_PETSC_CHECK(VecRestoreArray(on_fluid, &values));
     COAPT_PETSC_CHECK(VecRestoreArrayRead(fluid_state, &state));
   }
   COAPT_PETSC_CHECK(MatMultTranspose(coupling, on_fluid, on_solid));
   COAPT_PETSC_CHECK(VecSet(on_fluid, 1.0));
   COAPT_PETSC_CHECK(MatMultTranspose(coupling, on_fluid, weight));
-  auto result = fem::create_vertex_vector(*solid_, 1);
   {
     const PetscScalar *sum = nullptr, *total = nullptr;
     PetscScalar* values = nullptr;
     COAPT_PETSC_CHECK(VecGetArrayRead(on_solid, &sum));
     COAPT_PETSC_CHECK(VecGetArrayRead(weight, &total));
-    COAPT_PETSC_CHECK(VecGetArray(result, &values));
+    COAPT_PETSC_CHECK(VecGetArray(pressure, &values));
     for (int v = 0; v < solid_->n_owned_vertices; ++v)
       values[v] = total[v] > 0.0 ? sum[v] / total[v] : 0.0;
-    COAPT_PETSC_CHECK(VecRestoreArray(result, &values));
+    COAPT_PETSC_CHECK(VecRestoreArray(pressure, &values));
     COAPT_PETSC_CHECK(VecRestoreArrayRead(weight, &total));
     COAPT_PETSC_CHECK(VecRestoreArrayRead(on_solid, &sum));
   }
-  fem::update_ghosts(result);
-  return result;
+  fem::update_ghosts(pressure);
 }
 
 std::vector<double> ImmersedConstraint::sum_constrained(const std::vector<double>& values) const {

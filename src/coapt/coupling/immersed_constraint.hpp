@@ -131,9 +131,10 @@ class ImmersedConstraint {
 
   /// The fluid's pressure on the solid's vertices, p_j = (B^stdᵀ p_f)_j / Σ_i B^std_ij (0 at
   /// a vertex whose support the fluid mesh does not reach), from the fluid's state (u, p
-  /// interleaved, `fluid.dim + 1` components). A ghosted solid vertex vector, one component
-  /// [Pa]. Needs TransferOptions::primal. Collective.
-  OwnedVec solid_pressure(Vec fluid_state) const;
+  /// interleaved, `fluid.dim + 1` components), into `pressure` (a solid vertex vector with one
+  /// component, fem::create_vertex_vector; ghosts updated) [Pa]. Needs TransferOptions::primal.
+  /// Collective.
+  void solid_pressure(Vec fluid_state, Vec pressure) const;
 
   /// T v_s at the constrained vertices (constrained_vertices().size() × dim, row-major) from a
   /// solid vertex vector with dim components [m/s].

@@ -91,17 +91,14 @@ void add_vertex_integrals(const mesh::Mesh& mesh, std::vector<double>& mass,
     const auto cell = mesh.cell(c);
     const double* points[k];
     for (int a = 0; a < k; ++a) points[a] = mesh.point(cell[a]).data();
-    double edges[Dim][Dim], gradients[k][Dim];
-    fem::detail::edges_from_pointers<Dim>(points, edges);
-    const double measure = std::abs(fem::detail::gradients_from_edges<Dim>(edges, gradients)) /
-                           fem::detail::factorial(Dim);
+    const auto geometry = fem::p1_geometry<Dim>(points);
     for (int a = 0; a < k; ++a) {
       const int v = cell[a];
       if (v >= mesh.n_owned_vertices) continue;
       double square = 0;
-      for (int i = 0; i < Dim; ++i) square += gradients[a][i] * gradients[a][i];
-      mass[static_cast<std::size_t>(v)] += measure / k;
-      stiffness[static_cast<std::size_t>(v)] += measure * square;
+      for (int i = 0; i < Dim; ++i) square += geometry.gradients(a, i) * geometry.gradients(a, i);
+      mass[static_cast<std::size_t>(v)] += geometry.measure / k;
+      stiffness[static_cast<std::size_t>(v)] += geometry.measure * square;
     }
   }
 }
