@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Installs the Debian packages coapt builds and runs with (see docs/install.md).
+# Installs the Debian packages coapt builds and runs with (README.md, "Two commands").
 # Idempotent: packages already present are not touched and apt is not called at all
 # when nothing is missing. Uses sudo when not run as root.
 set -euo pipefail

@@ -18,6 +18,7 @@
 #include "coapt/coupling/immersed_constraint.hpp"
 #include "coapt/coupling/quasi_newton.hpp"
 #include "coapt/fem/assembly.hpp"
+#include "coapt/fem/p1.hpp"
 #include "coapt/fluid/fluid_model.hpp"
 #include "coapt/mesh/mesh_input.hpp"
 #include "coapt/solid/dynamics.hpp"
@@ -171,8 +172,10 @@ Parameters read(const config::Section& root) {
       {"",
        "load each deformable solid also with the fluid's pressure over its region, -int p div w: "
        "the solid then carries sigma_s + p I, as it carries rho_s - rho_f, so that a compressible "
-       "solid is squeezed by the pressure's level and not only pushed by its gradient (false: the "
-       "method as published)"});
+       "solid is squeezed by the pressure's level and not only pushed by its gradient; the "
+       "pressure is iterated with the force (relaxed with it, or in the IQN-ILS columns as "
+       "pressure times vertex measure) and its change counts in the coupling tolerance (false: "
+       "the method as published)"});
   p.transfer.search_margin = coupling.get<double>(
       "search_margin", 0.0,
       {"m", "motion of a solid the transfer's search structure absorbs before a rebuild",
@@ -363,8 +366,12 @@ struct Solid {
   /// (the force alone without coupling.iteration.iteration_density), and that inertia
   OwnedVec target, iteration_force;
   /// deformable, coupling.pressure_in_solid: the fluid's pressure the solid carries (one
-  /// component per solid vertex, from the last fluid solve) and its value at the step's start
-  OwnedVec pressure, pressure_start;
+  /// component per solid vertex), its value at the step's start and at the last iterate, the
+  /// pressure of the last fluid solve, and the difference of the two (updated with the force)
+  OwnedVec pressure, pressure_start, pressure_previous, pressure_target, pressure_residual;
+  /// The weight of each owned vertex's pressure among the forces of the coupling iteration:
+  /// ∫φ_v over the reference configuration [m² or m³], so that w p is a force.
+  std::vector<double> pressure_weight;
 
   /// Deformable: the model's current configuration into the mesh and the transfer (the
   /// constrained set is recomputed unless frozen). Collective.
@@ -574,10 +581,12 @@ class FsciProblem final : public run::Problem {
         }
         solid->model->set_external_force(solid->applied);
         if (parameters_.pressure_in_solid) {
-          for (auto* v : {&solid->pressure, &solid->pressure_start}) {
+          for (auto* v : {&solid->pressure, &solid->pressure_start, &solid->pressure_previous,
+                          &solid->pressure_target, &solid->pressure_residual}) {
             *v = fem::create_vertex_vector(solid->mesh, 1);
             COAPT_PETSC_CHECK(VecSet(*v, 0.0));
           }
+          solid->pressure_weight = vertex_measures(solid->mesh);
           try {
             solid->model->set_immersed_pressure(solid->pressure);
           } catch (const InputError& error) {
@@ -813,8 +822,9 @@ class FsciProblem final : public run::Problem {
   }
 
   /// The IQN-ILS columns kept for reuse, per deformable solid one field solid<k>_iqn with
-  /// 2 dim values per column and vertex (V's, then W's entries of the vertex), the columns of
-  /// the kept steps newest first; state["iqn_columns"]: the columns per kept step.
+  /// 2 m values per column and vertex (V's, then W's entries of the vertex; m = dim, or dim + 1
+  /// with the weighted pressure), the columns of the kept steps newest first;
+  /// state["iqn_columns"]: the columns per kept step.
   void write_quasi_newton(run::CheckpointWriter& writer) const {
     const auto& steps = quasi_newton_->reused();
     std::vector<std::int64_t> counts;
@@ -832,15 +842,15 @@ class FsciProblem final : public run::Problem {
         columns.size(), [&](std::size_t k, const Solid& solid, Vec packed, std::size_t offset) {
           PetscScalar* values = nullptr;
           COAPT_PETSC_CHECK(VecGetArray(packed, &values));
-          const int dim = solid.mesh.dim;
+          const int m = quasi_newton_components(solid);
           for (int v = 0; v < solid.mesh.n_owned_vertices; ++v)
             for (std::size_t c = 0; c < columns.size(); ++c)
-              for (int i = 0; i < dim; ++i)
-                values[packed_index(v, c, i, dim, columns.size())] =
-                    (*columns[c])[offset + static_cast<std::size_t>(v) * dim + i];
+              for (int i = 0; i < m; ++i)
+                values[packed_index(v, c, i, m, columns.size())] =
+                    (*columns[c])[offset + column_index(solid, v, i)];
           COAPT_PETSC_CHECK(VecRestoreArray(packed, &values));
           writer.add_vertex_field(fmt::format("solid{}_iqn", k), solid.mesh, packed,
-                                  static_cast<int>(columns.size()) * dim);
+                                  static_cast<int>(columns.size()) * m);
         });
   }
 
@@ -850,22 +860,39 @@ class FsciProblem final : public run::Problem {
            static_cast<std::size_t>(i);
   }
 
+  /// The IQN-ILS entries per owned vertex of a solid: dim forces, and its weighted pressure
+  /// with coupling.pressure_in_solid.
+  static int quasi_newton_components(const Solid& solid) {
+    return solid.mesh.dim + (solid.pressure ? 1 : 0);
+  }
+
+  /// Where entry i of owned vertex v lies in the solid's part of an IQN-ILS column: its forces
+  /// (dim per vertex), then its weighted pressures (quasi_newton_update).
+  static std::size_t column_index(const Solid& solid, int v, int i) {
+    const auto dim = static_cast<std::size_t>(solid.mesh.dim);
+    const auto vertex = static_cast<std::size_t>(v);
+    return i < solid.mesh.dim
+               ? vertex * dim + static_cast<std::size_t>(i)
+               : static_cast<std::size_t>(solid.mesh.n_owned_vertices) * dim + vertex;
+  }
+
   /// visit(k, solid, packed, offset) for each deformable solid k: `packed` a vector of its
-  /// owned vertices with n_columns × dim values each, `offset` where the solid's entries start
-  /// in a column (the solids' owned dofs one after the other, as in quasi_newton.hpp).
+  /// owned vertices with n_columns × quasi_newton_components values each, `offset` where the
+  /// solid's entries start in a column (the solids' parts one after the other, as in
+  /// quasi_newton_update).
   template <class Visit>
   void for_each_quasi_newton_field(std::size_t n_columns, Visit&& visit) const {
     std::size_t offset = 0;
     for (std::size_t k = 0; k < solids_.size(); ++k) {
       const auto& solid = *solids_[k];
       if (!solid.model) continue;
-      const int dim = solid.mesh.dim, owned = solid.mesh.n_owned_vertices;
+      const int m = quasi_newton_components(solid), owned = solid.mesh.n_owned_vertices;
       OwnedVec packed;
       COAPT_PETSC_CHECK(
-          VecCreateMPI(comm_, static_cast<PetscInt>(owned) * static_cast<PetscInt>(n_columns) * dim,
+          VecCreateMPI(comm_, static_cast<PetscInt>(owned) * static_cast<PetscInt>(n_columns) * m,
                        PETSC_DETERMINE, packed.out()));
       visit(k, solid, packed.get(), offset);
-      offset += static_cast<std::size_t>(owned) * dim;
+      offset += static_cast<std::size_t>(owned) * static_cast<std::size_t>(m);
     }
   }
 
@@ -881,7 +908,8 @@ class FsciProblem final : public run::Problem {
     }
     for (const auto& solid : solids_)
       if (solid->model)
-        length += static_cast<std::size_t>(solid->mesh.n_owned_vertices) * solid->mesh.dim;
+        length += static_cast<std::size_t>(solid->mesh.n_owned_vertices) *
+                  static_cast<std::size_t>(quasi_newton_components(*solid));
     std::vector<std::vector<double>*> columns;
     for (auto& step : steps)
       for (std::size_t j = 0; j < step.v.size(); ++j) {
@@ -893,16 +921,16 @@ class FsciProblem final : public run::Problem {
     if (n_columns > 0)
       for_each_quasi_newton_field(
           columns.size(), [&](std::size_t k, const Solid& solid, Vec packed, std::size_t offset) {
-            const int dim = solid.mesh.dim;
+            const int m = quasi_newton_components(solid);
             reader.read_vertex_field(fmt::format("solid{}_iqn", k), solid.mesh, packed,
-                                     static_cast<int>(columns.size()) * dim);
+                                     static_cast<int>(columns.size()) * m);
             const PetscScalar* values = nullptr;
             COAPT_PETSC_CHECK(VecGetArrayRead(packed, &values));
             for (int v = 0; v < solid.mesh.n_owned_vertices; ++v)
               for (std::size_t c = 0; c < columns.size(); ++c)
-                for (int i = 0; i < dim; ++i)
-                  (*columns[c])[offset + static_cast<std::size_t>(v) * dim + i] =
-                      values[packed_index(v, c, i, dim, columns.size())];
+                for (int i = 0; i < m; ++i)
+                  (*columns[c])[offset + column_index(solid, v, i)] =
+                      values[packed_index(v, c, i, m, columns.size())];
             COAPT_PETSC_CHECK(VecRestoreArrayRead(packed, &values));
           });
     quasi_newton_->restore_reused(std::move(steps));
@@ -1056,6 +1084,12 @@ class FsciProblem final : public run::Problem {
         for (auto& s : solids_)
           if (s->model)
             COAPT_PETSC_CHECK(VecWAXPY(s->applied, omega, s->residual, s->applied_previous));
+        for (auto& s : solids_)
+          if (s->pressure) {
+            COAPT_PETSC_CHECK(
+                VecWAXPY(s->pressure, omega, s->pressure_residual, s->pressure_previous));
+            fem::update_ghosts(s->pressure);
+          }
         report.history.push_back(std::numeric_limits<double>::quiet_NaN());
         report.relaxation.push_back(omega);
         fell_back = true;
@@ -1107,6 +1141,15 @@ class FsciProblem final : public run::Problem {
         }
         COAPT_PETSC_CHECK(VecCopy(solid->residual, solid->previous_residual));
       }
+      // coupling.pressure_in_solid: the pressure is iterated with the force, weighted as one
+      // (its change counts in the norm, and IQN-ILS takes it into its columns)
+      for (auto& solid : solids_) {
+        if (!solid->pressure) continue;
+        COAPT_PETSC_CHECK(
+            VecWAXPY(solid->pressure_residual, -1.0, solid->pressure, solid->pressure_target));
+        norm2 += weighted_square(*solid, solid->pressure_residual);
+        force2 += weighted_square(*solid, solid->pressure_target);
+      }
       const double norm = std::sqrt(norm2);
       if (iteration == 1) first_norm = std::sqrt(force2);
       report.history.push_back(norm);
@@ -1130,13 +1173,21 @@ class FsciProblem final : public run::Problem {
         break;
       }
       if (quasi_newton_) {
-        for (auto& solid : solids_)
+        for (auto& solid : solids_) {
           if (solid->model) COAPT_PETSC_CHECK(VecCopy(solid->applied, solid->applied_previous));
+          if (solid->pressure)
+            COAPT_PETSC_CHECK(VecCopy(solid->pressure, solid->pressure_previous));
+        }
         quasi_newton_update(omega);
         continue;
       }
-      for (auto& solid : solids_)
+      for (auto& solid : solids_) {
         if (solid->model) COAPT_PETSC_CHECK(VecAXPY(solid->applied, omega, solid->residual));
+        if (solid->pressure) {
+          COAPT_PETSC_CHECK(VecAXPY(solid->pressure, omega, solid->pressure_residual));
+          fem::update_ghosts(solid->pressure);
+        }
+      }
     }
     log::info("{}: {} coupling iteration(s){}, |f - f_applied| {:.3e}; {}",
               steady ? std::string("steady") : fmt::format("t = {:g} s", time), report.iterations,
@@ -1146,8 +1197,46 @@ class FsciProblem final : public run::Problem {
     return result;
   }
 
+  /// Σ_v (w_v x_v)² over the solid's vertices (w = pressure_weight), for a one-component
+  /// vertex vector x. Collective.
+  double weighted_square(const Solid& solid, Vec x) const {
+    const PetscScalar* values = nullptr;
+    COAPT_PETSC_CHECK(VecGetArrayRead(x, &values));
+    double sum = 0;
+    for (std::size_t v = 0; v < solid.pressure_weight.size(); ++v) {
+      const double weighted = solid.pressure_weight[v] * values[v];
+      sum += weighted * weighted;
+    }
+    COAPT_PETSC_CHECK(VecRestoreArrayRead(x, &values));
+    MPI_Allreduce(MPI_IN_PLACE, &sum, 1, MPI_DOUBLE, MPI_SUM, comm_);
+    return sum;
+  }
+
+  /// ∫φ_v over the mesh's cells for each owned vertex v (the lumped measure).
+  static std::vector<double> vertex_measures(const mesh::Mesh& mesh) {
+    std::vector<double> measures(static_cast<std::size_t>(mesh.n_owned_vertices), 0.0);
+    const auto add = [&]<int Dim>() {
+      constexpr int k = Dim + 1;
+      for (int c = 0; c < mesh.n_cells(); ++c) {
+        const auto cell = mesh.cell(c);
+        const double* points[k];
+        for (int a = 0; a < k; ++a) points[a] = mesh.point(cell[a]).data();
+        const double share = fem::p1_geometry<Dim>(points).measure / k;
+        for (int a = 0; a < k; ++a)
+          if (cell[a] < mesh.n_owned_vertices) measures[static_cast<std::size_t>(cell[a])] += share;
+      }
+    };
+    if (mesh.dim == 2)
+      add.template operator()<2>();
+    else
+      add.template operator()<3>();
+    return measures;
+  }
+
   /// The IQN-ILS update of the applied forces: x = the applied forces, x̃ = the forces of the
-  /// last fluid solve, over the owned entries of every deformable solid (quasi_newton.hpp).
+  /// last fluid solve, over the owned entries of every deformable solid (quasi_newton.hpp);
+  /// with coupling.pressure_in_solid each solid's w p follow its forces (x: the pressure it
+  /// carries, x̃: the last fluid solve's).
   void quasi_newton_update(double omega) {
     std::vector<double> x, x_tilde;
     const auto append = [](Vec vector, std::vector<double>& values) {
@@ -1158,10 +1247,21 @@ class FsciProblem final : public run::Problem {
       values.insert(values.end(), data, data + n);
       COAPT_PETSC_CHECK(VecRestoreArrayRead(vector, &data));
     };
+    const auto append_weighted = [](const Solid& solid, Vec vector, std::vector<double>& values) {
+      const PetscScalar* data = nullptr;
+      COAPT_PETSC_CHECK(VecGetArrayRead(vector, &data));
+      for (std::size_t v = 0; v < solid.pressure_weight.size(); ++v)
+        values.push_back(solid.pressure_weight[v] * data[v]);
+      COAPT_PETSC_CHECK(VecRestoreArrayRead(vector, &data));
+    };
     for (auto& solid : solids_)
       if (solid->model) {
         append(solid->applied, x);
         append(solid->target, x_tilde);
+        if (solid->pressure) {
+          append_weighted(*solid, solid->pressure, x);
+          append_weighted(*solid, solid->pressure_target, x_tilde);
+        }
       }
     std::vector<double> next(x.size());
     last_columns_ = quasi_newton_->next(x, x_tilde, omega, next);
@@ -1176,6 +1276,13 @@ class FsciProblem final : public run::Problem {
                 next.begin() + static_cast<std::ptrdiff_t>(offset) + n, data);
       COAPT_PETSC_CHECK(VecRestoreArray(solid->applied, &data));
       offset += static_cast<std::size_t>(n);
+      if (!solid->pressure) continue;
+      COAPT_PETSC_CHECK(VecGetArray(solid->pressure, &data));
+      for (std::size_t v = 0; v < solid->pressure_weight.size(); ++v)
+        data[v] = next[offset + v] / solid->pressure_weight[v];
+      COAPT_PETSC_CHECK(VecRestoreArray(solid->pressure, &data));
+      fem::update_ghosts(solid->pressure);
+      offset += solid->pressure_weight.size();
     }
   }
 
@@ -1261,7 +1368,8 @@ class FsciProblem final : public run::Problem {
       first += count;
       solid->constraint->add_partial_force(partial, solid->force);
       fem::update_ghosts(solid->force);
-      if (solid->pressure) solid->constraint->solid_pressure(fluid_.state(), solid->pressure);
+      if (solid->pressure)
+        solid->constraint->solid_pressure(fluid_.state(), solid->pressure_target);
       solid->total_force = solid->constraint->sum_components(solid->force);
       auto total_reaction = solid->constraint->sum_constrained(own);
       const auto partial_total = solid->constraint->sum_partial(partial);

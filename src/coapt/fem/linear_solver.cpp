@@ -20,12 +20,31 @@ LinearSolver::LinearSolver(MPI_Comm comm, const std::string& prefix,
   COAPT_PETSC_CHECK(KSPSetFromOptions(ksp_));
 }
 
-void LinearSolver::set_operator(Mat matrix) {
+void LinearSolver::set_operator(Mat matrix, bool keep_preconditioner) {
+  PC pc = nullptr;
+  COAPT_PETSC_CHECK(KSPGetPC(ksp_, &pc));
+  COAPT_PETSC_CHECK(PCSetReusePreconditioner(pc, keep_preconditioner ? PETSC_TRUE : PETSC_FALSE));
   COAPT_PETSC_CHECK(KSPSetOperators(ksp_, matrix, matrix));
 }
 
-SolveStats LinearSolver::solve(Vec rhs, Vec solution) {
-  COAPT_PETSC_CHECK(KSPSolve(ksp_, rhs, solution));
+bool LinearSolver::is_factorisation() const {
+  PC pc = nullptr;
+  COAPT_PETSC_CHECK(KSPGetPC(ksp_, &pc));
+  PetscBool factor = PETSC_FALSE;
+  COAPT_PETSC_CHECK(
+      PetscObjectTypeCompareAny(reinterpret_cast<PetscObject>(pc), &factor, PCLU, PCCHOLESKY, ""));
+  return factor == PETSC_TRUE;
+}
+
+SolveStats LinearSolver::solve(Vec rhs, Vec solution, int max_iterations) {
+  PetscReal rtol = 0, atol = 0, dtol = 0;
+  PetscInt configured = 0;
+  COAPT_PETSC_CHECK(KSPGetTolerances(ksp_, &rtol, &atol, &dtol, &configured));
+  const bool capped = max_iterations > 0 && max_iterations < configured;
+  if (capped) COAPT_PETSC_CHECK(KSPSetTolerances(ksp_, rtol, atol, dtol, max_iterations));
+  const PetscErrorCode code = KSPSolve(ksp_, rhs, solution);
+  if (capped) COAPT_PETSC_CHECK(KSPSetTolerances(ksp_, rtol, atol, dtol, configured));
+  COAPT_PETSC_CHECK(code);
   KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
   PetscInt iterations = 0;
   PetscReal residual = 0;
@@ -43,12 +62,9 @@ SolveStats LinearSolver::solve(Vec rhs, Vec solution) {
 }
 
 void LinearSolver::reset_factorisation() {
+  if (!is_factorisation()) return;
   PC pc = nullptr;
   COAPT_PETSC_CHECK(KSPGetPC(ksp_, &pc));
-  PetscBool factor = PETSC_FALSE;
-  COAPT_PETSC_CHECK(
-      PetscObjectTypeCompareAny(reinterpret_cast<PetscObject>(pc), &factor, PCLU, PCCHOLESKY, ""));
-  if (!factor) return;
   // PCReset drops the operators with the factor: keep them alive and set them again.
   Mat matrix = nullptr, preconditioner = nullptr;
   COAPT_PETSC_CHECK(KSPGetOperators(ksp_, &matrix, &preconditioner));

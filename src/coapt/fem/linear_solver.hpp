@@ -31,14 +31,19 @@ struct SolveStats {
 class LinearSolver {
  public:
   LinearSolver(MPI_Comm comm, const std::string& prefix, const LinearSolverDefaults& defaults);
-  /// Sets (or resets after re-assembly) the operator; the preconditioner is rebuilt.
-  void set_operator(Mat matrix);
+  /// Sets (or resets after re-assembly) the operator. The preconditioner is rebuilt, unless
+  /// `keep_preconditioner`: then the last one (built for an earlier matrix) preconditions the
+  /// Krylov method on this one.
+  void set_operator(Mat matrix, bool keep_preconditioner = false);
+  /// Whether the preconditioner is a factorisation (LU or Cholesky).
+  bool is_factorisation() const;
   /// Solves A x = b; throws ConvergenceError naming the prefix, the reason and the iterations.
   /// A failed factorisation (LU, Cholesky) is discarded first, so that the next solve analyses
   /// and factors afresh: MUMPS refuses every later numeric factorisation of an instance whose
   /// last one failed, which would make a retried step fail at its first solve whatever its
   /// matrix.
-  SolveStats solve(Vec rhs, Vec solution);
+  /// `max_iterations` > 0 caps this solve's iterations below the configured limit.
+  SolveStats solve(Vec rhs, Vec solution, int max_iterations = 0);
   KSP ksp() const { return ksp_.get(); }
   /// A one-line description ("cg + gamg").
   std::string describe() const;

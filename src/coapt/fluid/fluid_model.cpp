@@ -154,6 +154,15 @@ FluidCase FluidCase::read(const config::Section& section, const config::Section&
   p.fluid.newton_max_iterations =
       newton.get<int>("max_iterations", 25, {"", "Newton iterations", Bounds::closed(1, 1000)});
   p.fluid.newton_line_search = fem::read_line_search(newton);
+  p.fluid.reuse_preconditioner = newton.get<int>(
+      "reuse_preconditioner", 10,
+      {"",
+       "with a direct linear solver (the 2D default, or -fluid_pc_type lu): a time step's LU "
+       "factorisation serves its "
+       "later Newton and coupling iterations as GMRES's preconditioner until a solve on it needs "
+       "more than this many iterations, then the matrix is factored afresh; 0: factored at every "
+       "Newton iteration",
+       Bounds::closed(0, 100)});
 
   for (const auto& entry : section.sections("boundary", "boundary conditions, in order")) {
     BoundaryCondition bc;
@@ -413,10 +422,12 @@ NewtonReport FluidModel::solve_steady(const std::string& label) {
   level_ = TimeLevel{};
   write_boundary_values(std::numeric_limits<double>::infinity());
   set_outlet_pressures(0.0);
+  fluid_->refresh_preconditioner();
   return fluid_->solve(level_, label);
 }
 
 void FluidModel::begin_step(double dt) {
+  fluid_->refresh_preconditioner();
   level_.time_step = dt;
   level_.alpha = bdf_weights(steps_ == 0 ? 1 : 2, dt / (steps_ == 0 ? dt : last_step_));
   level_.previous = previous_;

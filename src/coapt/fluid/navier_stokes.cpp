@@ -24,7 +24,8 @@ namespace {
 /// iterations per Newton step grew by 1.3x or less per refinement on a 3D channel and 1.6x on
 /// DFG 3D-1Z (configure_preconditioner, update_schur_preconditioner); a Newton step needs only an
 /// inexact solve (1e-6 keeps the Newton residual histories of the direct solver). 2D: GMRES + LU
-/// (MUMPS, any number of ranks), 1 iteration per Newton step. The 2D meshes are small enough for
+/// (MUMPS, any number of ranks), 1 iteration per Newton step on a new factorisation, a few on a
+/// time step's reused one (solve_correction). The 2D meshes are small enough for
 /// it, and the fieldsplit took 55–105 iterations per step on DFG 2D-1 (the convection-dominated
 /// flow there is where the S_p above is weakest). docs/verification/fluid.md, "Linear solver", has
 /// the measurements; -fluid_pc_type fieldsplit or lu switches in either dimension.
@@ -126,6 +127,11 @@ NavierStokes::NavierStokes(const mesh::Mesh& mesh, const FluidParameters& parame
   COAPT_PETSC_CHECK(PCGetType(pc, &type));
   if (!given && type && std::string(type) == PCLU)
     COAPT_PETSC_CHECK(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+  // A reused factorisation needs a Krylov method around it: -fluid_ksp_type preonly applies it
+  // once, a stale Jacobian's Newton step.
+  KSPType ksp_type = nullptr;
+  COAPT_PETSC_CHECK(KSPGetType(solver_.ksp(), &ksp_type));
+  factorisation_ = solver_.is_factorisation() && ksp_type && std::string(ksp_type) != KSPPREONLY;
   // Rows of fixed dofs are zeroed in place: the CSR pattern P1Matrix writes into must stay.
   COAPT_PETSC_CHECK(MatSetOption(matrix_.mat(), MAT_KEEP_NONZERO_PATTERN, PETSC_TRUE));
 }
@@ -472,8 +478,9 @@ void NavierStokes::jacobian_action(const TimeLevel& time, Vec direction, Vec res
   }
 }
 
-int NavierStokes::solve_with_outlets(Vec rhs, Vec solution, const std::vector<PetscInt>& fixed) {
-  int iterations = solver_.solve(rhs, solution).iterations;
+int NavierStokes::solve_with_outlets(Vec rhs, Vec solution, const std::vector<PetscInt>& fixed,
+                                     int max_iterations) {
+  int iterations = solver_.solve(rhs, solution, max_iterations).iterations;
   std::vector<std::size_t> coupled;
   for (std::size_t k = 0; k < outlets_.size(); ++k)
     if (outlets_[k].resistance != 0.0) coupled.push_back(k);
@@ -493,7 +500,7 @@ int NavierStokes::solve_with_outlets(Vec rhs, Vec solution, const std::vector<Pe
     COAPT_PETSC_CHECK(VecAssemblyEnd(columns[j]));
     COAPT_PETSC_CHECK(VecDuplicate(columns[j], images[j].out()));
     COAPT_PETSC_CHECK(VecSet(images[j], 0.0));
-    iterations += solver_.solve(columns[j], images[j]).iterations;
+    iterations += solver_.solve(columns[j], images[j], max_iterations).iterations;
   }
   Eigen::MatrixXd capacitance(m, m);
   Eigen::VectorXd projected(m);
@@ -511,6 +518,32 @@ int NavierStokes::solve_with_outlets(Vec rhs, Vec solution, const std::vector<Pe
   const Eigen::VectorXd coefficients = capacitance.partialPivLu().solve(projected);
   for (std::size_t l = 0; l < m; ++l)
     COAPT_PETSC_CHECK(VecAXPY(solution, -coefficients(static_cast<Eigen::Index>(l)), images[l]));
+  return iterations;
+}
+
+int NavierStokes::solve_correction(const TimeLevel& time, const std::vector<PetscInt>& fixed,
+                                   NewtonReport& report) {
+  const int limit = factorisation_ ? parameters_.reuse_preconditioner : 0;
+  if (limit > 0 && preconditioner_current_) {
+    // GMRES on the time step's factorisation, capped: a solve that would need more than
+    // a few times the limit costs more than a new factorisation.
+    COAPT_PETSC_CHECK(VecSet(correction_, 0.0));
+    solver_.set_operator(matrix_.mat(), true);
+    try {
+      const int iterations = solve_with_outlets(free_residual_, correction_, fixed, 4 * limit);
+      if (iterations > limit) preconditioner_current_ = false;
+      return iterations;
+    } catch (const ConvergenceError& error) {
+      log::debug("fluid: {} on the reused factorisation; factoring afresh", error.what());
+    }
+  }
+  COAPT_PETSC_CHECK(VecSet(correction_, 0.0));
+  preconditioner_current_ = false;
+  solver_.set_operator(matrix_.mat());
+  if (user_schur_) update_schur_preconditioner(time);
+  ++report.preconditioner_setups;
+  const int iterations = solve_with_outlets(free_residual_, correction_, fixed, 0);
+  preconditioner_current_ = true;
   return iterations;
 }
 
@@ -674,11 +707,8 @@ NewtonReport NavierStokes::solve(const TimeLevel& time, const std::string& label
     COAPT_PETSC_CHECK(MatZeroRows(matrix_.mat(), static_cast<PetscInt>(fixed.size()), fixed.data(),
                                   scale, nullptr, nullptr));
     COAPT_PETSC_CHECK(VecScale(free_residual_, -1.0));
-    COAPT_PETSC_CHECK(VecSet(correction_, 0.0));
-    solver_.set_operator(matrix_.mat());
-    if (user_schur_) update_schur_preconditioner(time);
     try {
-      report.linear_iterations += solve_with_outlets(free_residual_, correction_, fixed);
+      report.linear_iterations += solve_correction(time, fixed, report);
     } catch (const ConvergenceError& error) {
       throw ConvergenceError(fmt::format("fluid Newton, {}, iteration {}: {}; residual history {}",
                                          label, iteration + 1, error.what(),

@@ -41,6 +41,12 @@ struct FluidParameters {
   /// Halvings of a Newton correction that raises ‖R‖ (backtracking while ‖R‖ stays above
   /// the last iterate's; the trial with the smallest ‖R‖ is kept); 0: full corrections.
   int newton_line_search = 0;
+  /// With a direct solver (LU, Cholesky): a factorisation serves the later Newton iterations
+  /// of its time step (and its coupling iterations) as GMRES's preconditioner until a solve
+  /// on it needs more than this many iterations; 0: factored at every Newton iteration.
+  /// Other preconditioners, and a factorisation applied alone (-fluid_ksp_type preonly), are
+  /// rebuilt at every Newton iteration.
+  int reuse_preconditioner = 10;
 };
 
 /// The time discretisation of one solve: steady (time_step ≤ 0) or a BDF step with
@@ -56,6 +62,7 @@ struct TimeLevel {
 struct NewtonReport {
   int iterations = 0;
   int linear_iterations = 0;             ///< summed over the Newton steps
+  int preconditioner_setups = 0;         ///< factorisations (or preconditioner builds)
   std::vector<double> residual_history;  ///< ‖R‖ of the free dofs, one per iterate
 };
 
@@ -123,6 +130,10 @@ class NavierStokes {
   /// Newton's method to the tolerances of FluidParameters; throws ConvergenceError with the
   /// residual history when it fails or meets a non-finite residual. `label` names the step.
   NewtonReport solve(const TimeLevel& time, const std::string& label);
+  /// The next Newton iteration rebuilds the preconditioner (FluidParameters::
+  /// reuse_preconditioner): called at the start of every time step and of every retry, so
+  /// that a step's solves do not depend on the steps before it (a restart repeats them).
+  void refresh_preconditioner() { preconditioner_current_ = false; }
 
   /// Force exerted by the fluid on the boundary group with facet tag `tag` [N/m in 2D, N in
   /// 3D], computed variationally: F_i = −R(u_h, p_h; w = e_i χ_Γ) with χ_Γ the P1 indicator of
@@ -160,8 +171,16 @@ class NavierStokes {
   /// κ_k of penalty entry k for this time level.
   double penalty_coefficient(std::size_t k, const TimeLevel& time) const;
   /// Solves (J + Σ_k R_k b̃_k b̃_kᵀ) x = rhs (b̃: b with fixed dofs zeroed) with the factorised
-  /// J and the Woodbury formula; returns the Krylov iterations of all solves.
-  int solve_with_outlets(Vec rhs, Vec solution, const std::vector<PetscInt>& fixed);
+  /// J and the Woodbury formula; returns the Krylov iterations of all solves, each capped at
+  /// `max_iterations` when > 0.
+  int solve_with_outlets(Vec rhs, Vec solution, const std::vector<PetscInt>& fixed,
+                         int max_iterations);
+  /// The Newton correction for −free_residual_ into correction_, with the assembled, row-fixed
+  /// matrix: on the reused preconditioner when FluidParameters::reuse_preconditioner allows
+  /// (factored afresh if GMRES fails on it), else on a new one (counted in `report`). Returns
+  /// the Krylov iterations.
+  int solve_correction(const TimeLevel& time, const std::vector<PetscInt>& fixed,
+                       NewtonReport& report);
 
   /// The default preconditioner (navier_stokes.cpp, solver_defaults): with -fluid_pc_type
   /// fieldsplit, velocity and pressure splits "u", "p" and a Schur complement factorisation
@@ -195,6 +214,9 @@ class NavierStokes {
   OwnedIS velocity_dofs_, pressure_dofs_;
   OwnedMat schur_preconditioner_;
   bool user_schur_ = false;  ///< update_schur_preconditioner supplies S_p
+  /// the preconditioner is LU or Cholesky inside a Krylov method (may be reused)
+  bool factorisation_ = false;
+  bool preconditioner_current_ = false;  ///< built in this time step, may be reused
 };
 
 }  // namespace coapt::fluid
