@@ -1153,12 +1153,18 @@ class FsciProblem final : public run::Problem {
       const double norm = std::sqrt(norm2);
       if (iteration == 1) first_norm = std::sqrt(force2);
       report.history.push_back(norm);
-      // one line per coupling iteration: a step of a large case can take many minutes
-      log::debug(
-          "coupling iteration {} to t = {:g} s: |f - f_applied| {:.3e} (tolerance {:.3e}), "
-          "fluid Newton {}, {} constrained fluid vertices",
-          iteration, time, norm, std::max(c.absolute_tolerance, c.relative_tolerance * first_norm),
+      // One line per coupling iteration: a step of a large case can take many minutes. A
+      // steady run has no per-step progress line, so there it is the progress (info).
+      const auto line = fmt::format(
+          "coupling iteration {}{}: |f - f_applied| {:.3e} (tolerance {:.3e}), fluid Newton {}, "
+          "{} constrained fluid vertices",
+          iteration, steady ? std::string() : fmt::format(" to t = {:g} s", time), norm,
+          std::max(c.absolute_tolerance, c.relative_tolerance * first_norm),
           report.fluid.iterations, n_constrained_);
+      if (steady)
+        log::info("{}", line);
+      else
+        log::debug("{}", line);
       if (iteration > 1 && c.method == CouplingSettings::Method::aitken && difference2 > 0)
         omega = std::clamp(-omega * dot / difference2, 0.01, 1.0);
       report.relaxation.push_back(quasi_newton_ ? std::numeric_limits<double>::quiet_NaN() : omega);

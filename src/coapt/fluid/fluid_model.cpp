@@ -157,11 +157,11 @@ FluidCase FluidCase::read(const config::Section& section, const config::Section&
   p.fluid.reuse_preconditioner = newton.get<int>(
       "reuse_preconditioner", 10,
       {"",
-       "with a direct linear solver (the 2D default, or -fluid_pc_type lu): a time step's LU "
-       "factorisation serves its "
-       "later Newton and coupling iterations as GMRES's preconditioner until a solve on it needs "
-       "more than this many iterations, then the matrix is factored afresh; 0: factored at every "
-       "Newton iteration",
+       "a time step's preconditioner serves its later Newton and coupling iterations: the LU "
+       "factorisation (the 2D default, or -fluid_pc_type lu) until a GMRES solve on it needs "
+       "more than this many iterations, in a time step the fieldsplit (the 3D default) until a "
+       "solve needs this many more than the last one on a new fieldsplit; then it is built "
+       "afresh. 0: built at every Newton iteration",
        Bounds::closed(0, 100)});
 
   for (const auto& entry : section.sections("boundary", "boundary conditions, in order")) {

@@ -214,9 +214,12 @@ class NavierStokes {
   OwnedIS velocity_dofs_, pressure_dofs_;
   OwnedMat schur_preconditioner_;
   bool user_schur_ = false;  ///< update_schur_preconditioner supplies S_p
-  /// the preconditioner is LU or Cholesky inside a Krylov method (may be reused)
+  /// the preconditioner is LU or Cholesky inside a Krylov method
   bool factorisation_ = false;
+  /// the preconditioner is a fieldsplit inside a Krylov method (reused within a time step)
+  bool fieldsplit_ = false;
   bool preconditioner_current_ = false;  ///< built in this time step, may be reused
+  int fresh_iterations_ = 0;  ///< Krylov iterations of the last solve on a new preconditioner
 };
 
 }  // namespace coapt::fluid
