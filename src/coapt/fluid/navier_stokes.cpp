@@ -725,7 +725,13 @@ NewtonReport NavierStokes::solve(const TimeLevel& time, const std::string& label
                                   scale, nullptr, nullptr));
     COAPT_PETSC_CHECK(VecScale(free_residual_, -1.0));
     try {
-      report.linear_iterations += solve_correction(time, fixed, report);
+      const int setups = report.preconditioner_setups;
+      const int linear = solve_correction(time, fixed, report);
+      report.linear_iterations += linear;
+      // a 3D Newton iteration can take minutes: one line each (--log-level debug)
+      log::debug("fluid Newton, {}: iteration {}, |R| {:.3e}, {} linear iterations{}", label,
+                 iteration + 1, norm, linear,
+                 report.preconditioner_setups > setups ? " (new preconditioner)" : "");
     } catch (const ConvergenceError& error) {
       throw ConvergenceError(fmt::format("fluid Newton, {}, iteration {}: {}; residual history {}",
                                          label, iteration + 1, error.what(),
