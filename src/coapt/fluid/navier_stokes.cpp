@@ -135,11 +135,8 @@ NavierStokes::NavierStokes(const mesh::Mesh& mesh, const FluidParameters& parame
   KSPType ksp_type = nullptr;
   COAPT_PETSC_CHECK(KSPGetType(solver_.ksp(), &ksp_type));
   const bool krylov = ksp_type && std::string(ksp_type) != KSPPREONLY;
-  PetscBool fieldsplit = PETSC_FALSE;
-  COAPT_PETSC_CHECK(
-      PetscObjectTypeCompare(reinterpret_cast<PetscObject>(pc), PCFIELDSPLIT, &fieldsplit));
   factorisation_ = solver_.is_factorisation() && krylov;
-  fieldsplit_ = fieldsplit && krylov;
+  fieldsplit_ = type && std::string(type) == PCFIELDSPLIT && krylov;
   // Rows of fixed dofs are zeroed in place: the CSR pattern P1Matrix writes into must stay.
   COAPT_PETSC_CHECK(MatSetOption(matrix_.mat(), MAT_KEEP_NONZERO_PATTERN, PETSC_TRUE));
 }
@@ -550,7 +547,7 @@ int NavierStokes::solve_correction(const TimeLevel& time, const std::vector<Pets
       if (iterations > allowed) preconditioner_current_ = false;
       return iterations;
     } catch (const ConvergenceError& error) {
-      log::debug("fluid: {} on the reused factorisation; factoring afresh", error.what());
+      log::debug("fluid: {} on the reused preconditioner; building it afresh", error.what());
     }
   }
   COAPT_PETSC_CHECK(VecSet(correction_, 0.0));
