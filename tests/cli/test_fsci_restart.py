@@ -22,6 +22,10 @@ contact-stabilized Newmark with mortar contact, IQN-ILS reusing the last 4 steps
   no retries) stops with exit status 1 and keeps the last good state (step 2) as a checkpoint:
   restarted from the failed run's folder with the factor 1, steps 3..4 are the straight run's
   bit for bit;
+- a step of the leaflets that fails (the pressure jumping to -1000 times 20 Pa over step 21, no
+  retries) leaves a checkpoint that is, file for file and bit for bit, the one the same run
+  stopped after step 20 writes: the failed tries' constrained nodes, force, contact state and
+  forgotten IQN-ILS columns are put back;
 - a checkpoint of a flow run and a checkpoint with other solids are refused with one error
   line naming the folder, exit 2.
 The fluid and the solid are solved by PETSc's own LU of the gathered matrix (ksp_type
@@ -87,6 +91,38 @@ def main():
         runner.expect(last["time"] == expected["time"] and worst < 1e-5,
                       f"restart on 1 rank: step 22 agrees to 1e-5 (largest relative difference "
                       f"{worst:.2e})")
+
+    # A step of the leaflets that fails keeps the last good state, all of it: the pressure
+    # jumps to -1000 (in units of the case's 20 Pa) over step 21, whose coupling does not
+    # converge in its 40 iterations (no retries). Its tries move the leaflets, the constrained
+    # fluid nodes, the force B^T lambda and the contact state, and the failure forgets the
+    # IQN-ILS columns; the checkpoint it leaves must be, file for file and bit for bit, the
+    # one the same run stopped after step 20 writes.
+    jump = ["--set", "fluid.outlets[0].waveform.times=[0,0.03,0.04,0.042,1]",
+            "--set", "fluid.outlets[0].waveform.values=[0,-1.5,-1.5,-1000,-1000]",
+            "--set", "coupling.iteration.retries=0"]
+    failed = run("fails", 0.044, *jump)
+    good = run("good", 0.040, *jump)
+    summary = read_json(work / "fails" / "summary.json")
+    runner.expect(failed.returncode == 1 and summary.get("status") == "failed"
+                  and summary.get("last_good_step") == 20,
+                  "leaflets: the step with the jump fails, exit 1, last good step 20",
+                  failed.stdout[-2000:] + failed.stderr[-2000:])
+    runner.expect(good.returncode == 0, "leaflets: the run stopped after step 20 succeeds",
+                  good.stderr[-2000:])
+    if failed.returncode == 1 and good.returncode == 0:
+        files = sorted(path.name for path in (work / "good" / "checkpoint").glob("*.bin"))
+        differ = [name for name in files
+                  if (work / "good" / "checkpoint" / name).read_bytes()
+                  != (work / "fails" / "checkpoint" / name).read_bytes()]
+        states = [read_json(work / name / "checkpoint" / "state.json")["state"]
+                  for name in ("good", "fails")]
+        differ += [key for key in states[0] if states[0][key] != states[1].get(key)]
+        print(f"checkpoint after the failed step: {len(files)} fields, IQN-ILS columns "
+              f"{states[1]['iqn_columns']}; differing from the last good step's: {differ or 'none'}")
+        runner.expect(len(files) > 0 and not differ and sum(states[1]["iqn_columns"]) > 0,
+                      "leaflets: the failed run's checkpoint is the last good step's bit for bit "
+                      "(fluid, leaflets, constrained nodes, force, contact, IQN-ILS columns)")
 
     rigid = runner.source / "cases" / "dfg" / "2d1_immersed.yaml"
     moving = ["--set", "output.vtk=false", "--set", "time.steady=false", "--set", "time.step=0.05",

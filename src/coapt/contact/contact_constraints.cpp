@@ -226,6 +226,41 @@ void ContactConstraints::restore_active(std::size_t p, Vec marker) {
     pair.active[j] = values[static_cast<std::size_t>(j) * dim_] > 0.5 ? 1 : 0;
 }
 
+ContactConstraints::Snapshot ContactConstraints::snapshot() const {
+  Snapshot snapshot;
+  snapshot.pairs.reserve(pairs_.size());
+  for (const auto& pair : pairs_) {
+    PairState state;
+    state.slave_x = pair.slave_x;
+    state.master_x = pair.master_x;
+    state.mortar = pair.mortar;
+    state.pressure = pair.pressure;
+    state.active = pair.active;
+    state.slave_residual = pair.slave_residual;
+    snapshot.pairs.push_back(std::move(state));
+  }
+  snapshot.status = status_;
+  snapshot.complementarity_constant = complementarity_constant_;
+  return snapshot;
+}
+
+void ContactConstraints::restore(const Snapshot& snapshot) {
+  if (snapshot.pairs.size() != pairs_.size())
+    throw InternalError("ContactConstraints::restore: a snapshot of other pairs");
+  for (std::size_t p = 0; p < pairs_.size(); ++p) {
+    const auto& state = snapshot.pairs[p];
+    auto& pair = pairs_[p];
+    pair.slave_x = state.slave_x;
+    pair.master_x = state.master_x;
+    pair.mortar = state.mortar;
+    pair.pressure = state.pressure;
+    pair.active = state.active;
+    pair.slave_residual = state.slave_residual;
+  }
+  status_ = snapshot.status;
+  complementarity_constant_ = snapshot.complementarity_constant;
+}
+
 void ContactConstraints::current_positions(std::size_t p, Vec u, std::vector<double>& slave_x,
                                            std::vector<double>& master_x) const {
   const auto& pair = pairs_[p];

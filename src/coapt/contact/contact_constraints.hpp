@@ -132,6 +132,20 @@ class ContactConstraints {
 
   const ContactStatus& status() const { return status_; }
   const std::vector<PairState>& pairs() const { return pairs_; }
+
+  /// What an update changes: each pair's current coordinates, mortar operators, pressures,
+  /// active set and slave residual, the status and c. Taken before a coupled step and put
+  /// back after it fails, so that the next try, the output and the checkpoint start from the
+  /// last good state's contact, not the failed try's.
+  struct Snapshot {
+    std::vector<PairState> pairs;  ///< the surfaces left empty
+    ContactStatus status;
+    double complementarity_constant = 0.0;
+  };
+  Snapshot snapshot() const;
+  /// Puts a snapshot of these pairs back. Not collective (the pair states are the same on
+  /// every rank).
+  void restore(const Snapshot& snapshot);
   /// Vertex fields over the local vertices of the mesh (owned and ghost): contact pressure
   /// [Pa], gap [m] and active flag (1/0) at slave nodes, 0 elsewhere.
   void vertex_fields(std::vector<double>& pressure, std::vector<double>& gap,

@@ -132,6 +132,21 @@ class ContactHook final : public solid::NewtonHook {
   /// Takes it back; InputError naming the checkpoint folder when its pairs are not these.
   void read_checkpoint(const run::CheckpointReader& reader, const std::string& prefix);
 
+  /// The contact state and the step's counts of active-set changes (ContactConstraints::
+  /// Snapshot): taken before a coupled step, put back after it fails.
+  struct Snapshot {
+    ContactConstraints::Snapshot constraints;
+    int changing_iterations = 0, changed_nodes = 0;
+  };
+  Snapshot snapshot() const {
+    return {constraints_.snapshot(), changing_iterations_, changed_nodes_};
+  }
+  void restore(const Snapshot& snapshot) {
+    constraints_.restore(snapshot.constraints);
+    changing_iterations_ = snapshot.changing_iterations;
+    changed_nodes_ = snapshot.changed_nodes;
+  }
+
  private:
   ContactParameters parameters_;
   const mesh::Mesh& mesh_;

@@ -8,6 +8,7 @@
 #include <deque>
 #include <limits>
 #include <memory>
+#include <optional>
 
 #include "coapt/contact/solid_contact.hpp"
 #include "coapt/core/context.hpp"
@@ -373,12 +374,50 @@ struct Solid {
   /// ∫φ_v over the reference configuration [m² or m³], so that w p is a force.
   std::vector<double> pressure_weight;
 
+  /// What a coupled step's tries change besides the solid model's own state (which
+  /// SolidModel::restore puts back): the constrained set and its frozen flag, Bᵀλ and the
+  /// contact state, as the last committed step left them. A failed step puts them back
+  /// (restore_committed), so that its retry, the output written after the failure and the
+  /// checkpoint are the last good state's, not the failed try's.
+  struct Committed {
+    std::vector<int> constrained;
+    bool frozen = false;
+    OwnedVec force;
+    std::vector<double> total_force;
+    std::optional<contact::ContactHook::Snapshot> contact;
+  } committed;
+
   /// Deformable: the model's current configuration into the mesh and the transfer (the
   /// constrained set is recomputed unless frozen). Collective.
   void update_configuration() {
     const auto coordinates = model->current_coordinates();
     std::copy(coordinates.begin(), coordinates.end(), mesh.coordinates.begin());
     constraint->update_solid(mesh);
+  }
+
+  /// Takes `committed` from the current (committed) state.
+  void save_committed() {
+    committed.constrained = constraint->constrained_vertices();
+    committed.frozen = constraint->frozen();
+    if (!committed.force) COAPT_PETSC_CHECK(VecDuplicate(force, committed.force.out()));
+    COAPT_PETSC_CHECK(VecCopy(force, committed.force));
+    committed.total_force = total_force;
+    if (contact) committed.contact = contact->snapshot();
+  }
+
+  /// Puts `committed` back after a failed try, the solid already at its committed
+  /// configuration (a deformable one by SolidModel::restore, a rigid one by its coordinates):
+  /// the transfer re-assembled there with the committed set, as read_checkpoint does.
+  /// Collective.
+  void restore_committed() {
+    if (model) {
+      const auto coordinates = model->current_coordinates();
+      std::copy(coordinates.begin(), coordinates.end(), mesh.coordinates.begin());
+    }
+    constraint->restore(mesh, committed.constrained, committed.frozen);
+    COAPT_PETSC_CHECK(VecCopy(committed.force, force));
+    total_force = committed.total_force;
+    if (contact && committed.contact) contact->restore(*committed.contact);
   }
 };
 
@@ -959,6 +998,11 @@ class FsciProblem final : public run::Problem {
     for (const auto& solid : solids_)
       committed_coordinates.push_back(solid->model ? std::vector<double>{}
                                                    : solid->mesh.coordinates);
+    for (auto& solid : solids_) solid->save_committed();
+    const double committed_balance = force_balance_;
+    // The IQN-ILS columns of the past steps, kept from the first failed try (which forgets
+    // them) for the checkpoint of a step that fails altogether.
+    std::optional<std::deque<InterfaceQuasiNewton::Columns>> committed_columns;
     for (int attempt = 0; attempt <= c.retries; ++attempt) {
       if (attempt > 0) {
         if (deformable_ && !relaxation_tried && !first_solve_failed_) {
@@ -994,7 +1038,10 @@ class FsciProblem final : public run::Problem {
             fmt::format("\n  try {} (step {:g} s, relaxation {:g}): |df| {:.3e}", attempt + 1, step,
                         relaxation, fmt::join(result.coupling.history, ", "));
       fluid_.restore_step();
-      if (quasi_newton_) quasi_newton_->reset();
+      if (quasi_newton_) {
+        if (!committed_columns) committed_columns = quasi_newton_->reused();
+        quasi_newton_->reset();
+      }
       for (std::size_t k = 0; k < solids_.size(); ++k) {
         auto& solid = *solids_[k];
         if (solid.model) {
@@ -1004,13 +1051,15 @@ class FsciProblem final : public run::Problem {
             COAPT_PETSC_CHECK(VecCopy(solid.pressure_start, solid.pressure));
             fem::update_ghosts(solid.pressure);
           }
-        } else if (solid.mesh.coordinates != committed_coordinates[k]) {
+        } else {
           solid.mesh.coordinates = committed_coordinates[k];
-          solid.constraint->update_solid(solid.mesh);
         }
+        solid.restore_committed();
       }
       group_->combine();
+      force_balance_ = committed_balance;
     }
+    if (committed_columns) quasi_newton_->restore_reused(std::move(*committed_columns));
     throw ConvergenceError(fmt::format("fsci: the step from t = {:g} s failed after {} tries:{}",
                                        fluid_.time(), c.retries + 1, failures));
   }
