@@ -30,6 +30,17 @@ namespace {
 
 using config::Bounds;
 
+/// A coupling iteration's |df| history for the log: an iteration whose solid solve failed (its
+/// entry NaN, `coupled_step`) reads as such, not as a NaN of the iteration.
+std::string history_text(const std::vector<double>& history) {
+  std::string text;
+  for (const double change : history) {
+    if (!text.empty()) text += ", ";
+    text += std::isnan(change) ? std::string("(solid failed)") : fmt::format("{:.3e}", change);
+  }
+  return text;
+}
+
 /// One entry of `solids:`.
 struct SolidEntry {
   std::string name;
@@ -655,8 +666,8 @@ class FsciProblem final : public run::Problem {
       if (!report.converged)
         throw ConvergenceError(
             fmt::format("fsci: the steady coupling did not converge in {} iterations; |df| "
-                        "history {:.3e}",
-                        report.coupling.iterations, fmt::join(report.coupling.history, ", ")));
+                        "history {}",
+                        report.coupling.iterations, history_text(report.coupling.history)));
       newton_total = report.coupling.newton_iterations;
       linear_total = report.coupling.linear_iterations;
       coupling_total = report.coupling.iterations;
@@ -1035,8 +1046,8 @@ class FsciProblem final : public run::Problem {
       }
       if (!result.coupling.history.empty())
         failures +=
-            fmt::format("\n  try {} (step {:g} s, relaxation {:g}): |df| {:.3e}", attempt + 1, step,
-                        relaxation, fmt::join(result.coupling.history, ", "));
+            fmt::format("\n  try {} (step {:g} s, relaxation {:g}): |df| {}", attempt + 1, step,
+                        relaxation, history_text(result.coupling.history));
       fluid_.restore_step();
       if (quasi_newton_) {
         if (!committed_columns) committed_columns = quasi_newton_->reused();
@@ -1244,9 +1255,9 @@ class FsciProblem final : public run::Problem {
         }
       }
     }
-    log::info("{}: {} coupling iteration(s){}, |f - f_applied| {:.3e}; {}",
+    log::info("{}: {} coupling iteration(s){}, |f - f_applied| {}; {}",
               steady ? std::string("steady") : fmt::format("t = {:g} s", time), report.iterations,
-              result.converged ? "" : " (not converged)", fmt::join(report.history, ", "),
+              result.converged ? "" : " (not converged)", history_text(report.history),
               quasi_newton_ ? fmt::format("IQN-ILS, {} column(s) in the last update", last_columns_)
                             : fmt::format("omega {:.3f}", fmt::join(report.relaxation, ", ")));
     return result;
