@@ -1045,9 +1045,8 @@ class FsciProblem final : public run::Problem {
         return result.coupling;
       }
       if (!result.coupling.history.empty())
-        failures +=
-            fmt::format("\n  try {} (step {:g} s, relaxation {:g}): |df| {}", attempt + 1, step,
-                        relaxation, history_text(result.coupling.history));
+        failures += fmt::format("\n  try {} (step {:g} s, relaxation {:g}): |df| {}", attempt + 1,
+                                step, relaxation, history_text(result.coupling.history));
       fluid_.restore_step();
       if (quasi_newton_) {
         if (!committed_columns) committed_columns = quasi_newton_->reused();
