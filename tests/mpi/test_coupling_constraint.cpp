@@ -17,7 +17,9 @@
 //    follow their coverage and change continuously as the solid moves, their targets are
 //    averages of the solid's velocity, the force balance holds with them, and their blocking
 //    lies between the two covered-node rules they interpolate; a penalty of a very large
-//    weight gives the constraint's velocities and reactions (NavierStokes::set_velocity_penalty).
+//    weight gives the constraint's velocities and reactions (NavierStokes::set_velocity_penalty);
+//    the penalty's stiffness κ follows 1/Δt by default and is the same for every Δt with a
+//    time scale τ (coupling.partial_time_scale).
 
 #include <gtest/gtest.h>
 #include <petscvec.h>
@@ -479,6 +481,68 @@ TEST(CouplingConstraint, StiffPenaltyIsTheConstraint) {
   EXPECT_GT(constrained_force, 0.0);
   EXPECT_NEAR(penalty_force, constrained_force, 1e-6 * constrained_force);
   EXPECT_LT(held, 1e-7);
+}
+
+/// The penalty's stiffness κ_k = r_k / (u_k − w_k) at the partly covered nodes of the square
+/// held at rest, after one transient step of size dt from rest with the penalty's time scale tau
+/// (0: the step's own inertia); the nodes whose velocity is below 1e-6 are left out (nan).
+std::vector<double> penalty_stiffness(double dt, double tau) {
+  FluidModel fluid(read_case(), kWorld);
+  const Mesh solid = solid_square();
+  coapt::transfer::TransferOptions options;
+  options.coverage_threshold = 0.9;
+  ImmersedConstraint constraint(fluid.mesh(), solid, options, {}, 0.1);
+  fluid.start(0.0);
+  fluid.set_velocity_constraint(constraint.constrained_vertices(),
+                                constraint.transfer_uniform_velocity({0.0, 0.0}));
+  fluid.set_velocity_penalty(constraint.partial_vertices(), constraint.partial_weights(),
+                             constraint.partial_uniform_velocity({0.0, 0.0}), tau);
+  fluid.begin_step(dt);
+  fluid.solve("step");
+  const auto reactions = fluid.penalty_reactions();
+  coapt::fem::LocalValues state(fluid.state());
+  const auto& partial = constraint.partial_vertices();
+  std::vector<double> stiffness(partial.size(), std::nan(""));
+  for (std::size_t q = 0; q < partial.size(); ++q) {
+    const double u = state[3 * static_cast<std::size_t>(partial[q])];
+    if (std::abs(u) > 1e-6) stiffness[q] = reactions[2 * q] / u;
+  }
+  return stiffness;
+}
+
+TEST(CouplingConstraint, PenaltyTimeScaleFixesItsStiffness) {
+  // Without a time scale the inertial part ρ α₀ m / Δt doubles when Δt halves; with one it is
+  // ρ m / τ for every Δt. The viscous part (μ = 0.01 against ρ m / Δt ≈ 0.05–0.1 here) is the
+  // same in both.
+  const auto own_long = penalty_stiffness(0.05, 0.0), own_short = penalty_stiffness(0.025, 0.0);
+  const auto fixed_long = penalty_stiffness(0.05, 0.04),
+             fixed_short = penalty_stiffness(0.025, 0.04);
+  ASSERT_EQ(own_long.size(), own_short.size());
+  double fixed_change = 0, own_ratio_low = 1e300, own_ratio_high = 0;
+  long long compared = 0;
+  for (std::size_t q = 0; q < own_long.size(); ++q) {
+    if (std::isnan(own_long[q]) || std::isnan(own_short[q]) || std::isnan(fixed_long[q]) ||
+        std::isnan(fixed_short[q]))
+      continue;
+    ++compared;
+    EXPECT_GT(fixed_long[q], 0.0);
+    fixed_change = std::max(fixed_change, std::abs(fixed_short[q] / fixed_long[q] - 1.0));
+    own_ratio_low = std::min(own_ratio_low, own_short[q] / own_long[q]);
+    own_ratio_high = std::max(own_ratio_high, own_short[q] / own_long[q]);
+  }
+  MPI_Allreduce(MPI_IN_PLACE, &compared, 1, MPI_LONG_LONG, MPI_SUM, kWorld);
+  MPI_Allreduce(MPI_IN_PLACE, &fixed_change, 1, MPI_DOUBLE, MPI_MAX, kWorld);
+  MPI_Allreduce(MPI_IN_PLACE, &own_ratio_low, 1, MPI_DOUBLE, MPI_MIN, kWorld);
+  MPI_Allreduce(MPI_IN_PLACE, &own_ratio_high, 1, MPI_DOUBLE, MPI_MAX, kWorld);
+  if (coapt::rank_of(kWorld) == 0)
+    std::printf(
+        "penalty stiffness over %lld nodes: dt/2 changes it by x%.6f..x%.6f without a "
+        "time scale, by at most %.3e with tau = 0.04\n",
+        compared, own_ratio_low, own_ratio_high, fixed_change);
+  EXPECT_GT(compared, 0);
+  EXPECT_LT(fixed_change, 1e-9);
+  EXPECT_GT(own_ratio_low, 1.5);  // nearly 2: the viscous part does not change
+  EXPECT_LT(own_ratio_high, 2.0 + 1e-9);
 }
 
 }  // namespace

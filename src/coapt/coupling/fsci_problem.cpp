@@ -101,8 +101,9 @@ struct Parameters {
   fluid::FluidCase fluid;
   std::vector<SolidEntry> solids;
   transfer::TransferOptions transfer;
-  double partial_from = 1.0;       ///< coupling.partial_coverage_from (≥ the threshold: none)
-  bool pressure_in_solid = false;  ///< coupling.pressure_in_solid (ImmersedConstraint)
+  double partial_from = 1.0;        ///< coupling.partial_coverage_from (≥ the threshold: none)
+  double partial_time_scale = 0.0;  ///< coupling.partial_time_scale [s] (0: the step)
+  bool pressure_in_solid = false;   ///< coupling.pressure_in_solid (ImmersedConstraint)
   CouplingSettings coupling;
   fluid::TimeSettings time;
   Benchmark benchmark;
@@ -175,6 +176,13 @@ Parameters read(const config::Section& root) {
        "coverage_threshold is drawn towards the solid's velocity by a penalty that grows from 0 "
        "here to the constraint at the threshold (continuous in the solid's motion; 1: none)",
        Bounds{0.0, 1.0, true, false}});
+  p.partial_time_scale = coupling.get<double>(
+      "partial_time_scale", 0.0,
+      {"s",
+       "transient partial coverage: the penalty's inertial part is rho m_i / tau with this tau, "
+       "the same for every step size, a drag of fixed strength (0: rho alpha_0 m_i / dt, the "
+       "node's own BDF inertia, which stiffens the penalty as dt falls)",
+       Bounds::non_negative()});
   if (p.partial_from < 1.0 && !(p.partial_from < p.transfer.coverage_threshold))
     coupling.fail("partial_coverage_from",
                   fmt::format("must lie below coverage_threshold ({:g}), got {:g}",
@@ -1407,7 +1415,7 @@ class FsciProblem final : public run::Problem {
       }
       targets.insert(targets.end(), velocity.begin(), velocity.end());
     }
-    fluid_.set_velocity_penalty(vertices, weights, targets);
+    fluid_.set_velocity_penalty(vertices, weights, targets, parameters_.partial_time_scale);
     auto count = static_cast<long long>(merged.vertices.size());
     MPI_Allreduce(MPI_IN_PLACE, &count, 1, MPI_LONG_LONG, MPI_SUM, comm_);
     n_constrained_ = count;

@@ -531,8 +531,8 @@ std::vector<double> FluidModel::constraint_reactions() {
 
 void FluidModel::set_velocity_penalty(std::span<const int> vertices,
                                       std::span<const double> weights,
-                                      std::span<const double> targets) {
-  fluid_->set_velocity_penalty(vertices, weights, targets);
+                                      std::span<const double> targets, double time_scale) {
+  fluid_->set_velocity_penalty(vertices, weights, targets, time_scale);
 }
 
 std::vector<double> FluidModel::penalty_reactions() {

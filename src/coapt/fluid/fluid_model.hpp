@@ -189,9 +189,10 @@ class FluidModel {
   /// at the current state [N/m in 2D, N in 3D].
   std::vector<double> constraint_reactions();
   /// Draws the velocity at owned local vertices towards targets by a penalty of the given
-  /// weights (NavierStokes::set_velocity_penalty) for the following solves.
+  /// weights and inertial time scale (NavierStokes::set_velocity_penalty) for the following
+  /// solves.
   void set_velocity_penalty(std::span<const int> vertices, std::span<const double> weights,
-                            std::span<const double> targets);
+                            std::span<const double> targets, double time_scale = 0.0);
   /// The force the fluid exerts on each penalty entry (same layout) at the current state.
   std::vector<double> penalty_reactions();
   /// Force of the fluid on the boundary group with facet tag `tag` at the current state: the

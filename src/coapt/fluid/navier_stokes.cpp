@@ -304,8 +304,9 @@ void NavierStokes::set_velocity_constraint(std::span<const int> vertices,
 
 void NavierStokes::set_velocity_penalty(std::span<const int> vertices,
                                         std::span<const double> weights,
-                                        std::span<const double> targets) {
+                                        std::span<const double> targets, double time_scale) {
   const int dim = mesh_.dim;
+  if (!(time_scale >= 0.0)) throw InternalError("set_velocity_penalty: time_scale must be >= 0");
   if (weights.size() != vertices.size() ||
       targets.size() != vertices.size() * static_cast<std::size_t>(dim))
     throw InternalError("set_velocity_penalty: one weight and dim targets per vertex");
@@ -315,6 +316,7 @@ void NavierStokes::set_velocity_penalty(std::span<const int> vertices,
   penalty_vertices_.assign(vertices.begin(), vertices.end());
   penalty_weights_.assign(weights.begin(), weights.end());
   penalty_targets_.assign(targets.begin(), targets.end());
+  penalty_time_scale_ = time_scale;
   int active = penalty_vertices_.empty() ? 0 : 1;  // add_penalty is collective
   MPI_Allreduce(MPI_IN_PLACE, &active, 1, MPI_INT, MPI_MAX, mesh_.comm);
   penalty_active_ = active != 0;
@@ -333,7 +335,9 @@ double NavierStokes::penalty_coefficient(std::size_t k, const TimeLevel& time) c
   const auto v = static_cast<std::size_t>(penalty_vertices_[k]);
   double scale = parameters_.viscosity * stiffness_[v];
   if (time.time_step > 0)
-    scale += parameters_.density * time.alpha[0] * lumped_mass_[v] / time.time_step;
+    scale += penalty_time_scale_ > 0.0
+                 ? parameters_.density * lumped_mass_[v] / penalty_time_scale_
+                 : parameters_.density * time.alpha[0] * lumped_mass_[v] / time.time_step;
   return penalty_weights_[k] * scale;
 }
 

@@ -99,11 +99,13 @@ class NavierStokes {
   /// × dim, row-major) [m/s] by a penalty: R_(v,i) += κ_k (u_(v,i) − w_(k,i)) with
   /// κ_k = weights[k] · (ρ α₀ m_v / Δt + μ g_v), m_v = ∫φ_v and g_v = ∫|∇φ_v|² (steady: the
   /// viscous part alone), so a weight of 1 is as strong as the node's own inertia and
-  /// viscosity and a weight → ∞ tends to the constraint u = w. A vertex may appear more than
-  /// once (several solids' penalties add). Replaces the previous penalty. Not on a vertex of
-  /// the velocity constraint or a Dirichlet dof (the constraint wins there).
+  /// viscosity and a weight → ∞ tends to the constraint u = w. With time_scale τ > 0 the
+  /// inertial part is ρ m_v / τ instead, the same for every Δt (transient runs), so that the
+  /// penalty is a drag of fixed strength and not one that stiffens as Δt → 0. A vertex may
+  /// appear more than once (several solids' penalties add). Replaces the previous penalty.
+  /// Not on a vertex of the velocity constraint or a Dirichlet dof (the constraint wins there).
   void set_velocity_penalty(std::span<const int> vertices, std::span<const double> weights,
-                            std::span<const double> targets);
+                            std::span<const double> targets, double time_scale = 0.0);
   /// The force the fluid exerts on each penalty entry (set_velocity_penalty's order and layout),
   /// κ_k (u_v − w_k) [N/m or N]: at a converged solve, −R of the momentum equations without
   /// the penalty, like constraint_reactions.
@@ -209,7 +211,8 @@ class NavierStokes {
   /// vertex ∫φ_v and ∫|∇φ_v|² (computed on the first penalty).
   std::vector<int> penalty_vertices_;
   std::vector<double> penalty_weights_, penalty_targets_, lumped_mass_, stiffness_;
-  bool penalty_active_ = false;  ///< some rank has penalty vertices
+  double penalty_time_scale_ = 0.0;  ///< τ of the inertial part [s] (0: the step, ρ α₀ m/Δt)
+  bool penalty_active_ = false;      ///< some rank has penalty vertices
   /// Owned velocity and pressure dofs (the splits) and the assembled Schur preconditioner.
   OwnedIS velocity_dofs_, pressure_dofs_;
   OwnedMat schur_preconditioner_;
