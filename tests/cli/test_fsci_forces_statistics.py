@@ -9,7 +9,8 @@ from the first steps on; 80 steps of 2 ms, statistics from t = 0.03 s.
    displacement_y as {mean, amplitude, frequency, periods, final};
  - each of them equals, to 1e-9 relative, the statistics recomputed here from series.csv
    (the rows from statistics_from on) by the documented rule: periods between successive
-   upward crossings of the record's mid-level with hysteresis a quarter of its range, the
+   upward crossings of the record's mid-level with hysteresis a quarter of its range (the
+   range without its ⌊(n − 1)/100⌋ largest and smallest samples: none on these 66 rows), the
    last full period's largest and smallest samples refined by a parabola through their
    neighbours; mean = (max + min)/2, amplitude = (max − min)/2, frequency = 1/period;
  - drag and displacement_x complete at least two full periods, at 25 Hz to 1 % (the
@@ -56,7 +57,11 @@ def last_period(t, y):
     """(mean, amplitude, frequency, periods) of the last full period, None's if there is none."""
     if len(t) < 5:
         return None, None, None, 0
-    top, bottom = max(y), min(y)
+    ordered = sorted(value for value in y if math.isfinite(value))
+    if len(ordered) < 5:
+        return None, None, None, 0
+    set_aside = (len(ordered) - 1) // 100  # a one- or two-step spike must not set the level
+    top, bottom = ordered[-1 - set_aside], ordered[set_aside]
     level, band = 0.5 * (top + bottom), 0.25 * (top - bottom)
     if not band > 0:
         return None, None, None, 0

@@ -79,23 +79,28 @@ inline std::pair<double, double> parabola_vertex(std::span<const double> t,
 }  // namespace detail
 
 /// Summary of the last full period of y(t) (times increasing). Periods are delimited by
-/// successive upward crossings of the mid-level m = (max + min)/2 of the whole record, with
-/// hysteresis: a crossing counts only after the signal has been below m − δ, δ = (max − min)/4,
-/// and is the first sample interval after that going from below m to at or above it, its time
-/// interpolated linearly. Crossings, where the signal is steep, are timed far more robustly
-/// than flat crests, which small higher-mode wiggles shift by whole samples. The last full
-/// period is [t_k−1, t_k] between the last two crossings: the frequency is 1/(t_k − t_k−1),
-/// mean and amplitude come from the largest and smallest samples in it, each refined by a
-/// parabola through it and its two neighbours.
+/// successive upward crossings of the mid-level m = (top + bottom)/2 of the whole record, with
+/// hysteresis: a crossing counts only after the signal has been below m − δ, δ = (top −
+/// bottom)/4, and is the first sample interval after that going from below m to at or above
+/// it, its time interpolated linearly. top and bottom are the extremes of the record's n finite
+/// samples after setting aside the ⌊(n − 1)/100⌋ largest and smallest (none below 101
+/// samples): a spike of a step or two, such as the first step after a restart with changed
+/// options, must not lift the level out of the oscillation's reach. Crossings, where the
+/// signal is steep, are timed far more robustly than flat crests, which small higher-mode
+/// wiggles shift by whole samples. The last full period is [t_k−1, t_k] between the last two
+/// crossings: the frequency is 1/(t_k − t_k−1), mean and amplitude come from the largest and
+/// smallest samples in it, each refined by a parabola through it and its two neighbours.
 inline OscillationSummary last_period(std::span<const double> t, std::span<const double> y) {
   OscillationSummary summary;
   const std::size_t n = std::min(t.size(), y.size());
   if (n < 5) return summary;
-  double top = y[0], bottom = y[0];
-  for (std::size_t i = 0; i < n; ++i) {
-    top = std::max(top, y[i]);
-    bottom = std::min(bottom, y[i]);
-  }
+  std::vector<double> sorted;  // the finite samples (sorting a NaN is undefined)
+  for (std::size_t i = 0; i < n; ++i)
+    if (std::isfinite(y[i])) sorted.push_back(y[i]);
+  if (sorted.size() < 5) return summary;
+  std::sort(sorted.begin(), sorted.end());
+  const std::size_t set_aside = (sorted.size() - 1) / 100;
+  const double top = sorted[sorted.size() - 1 - set_aside], bottom = sorted[set_aside];
   const double level = 0.5 * (top + bottom), band = 0.25 * (top - bottom);
   if (!(band > 0.0)) return summary;
   std::vector<double> crossings;
