@@ -276,8 +276,9 @@ Parameters read(const config::Section& root) {
         "upstream_surfaces", {},
         {"",
          "boundary groups of the solid that face flow_boundary's side of the closed valve: "
-         "the rate at which they sweep that side (their flux of the solid velocity) is taken "
-         "from the flow, so that the leak excludes the fluid the moving leaflets push out; "
+         "the rate at which they sweep that side (the volume they sweep over the step, over "
+         "dt) is taken from the flow, so that the leak excludes the fluid the moving leaflets "
+         "push out; "
          "empty: the leak is the whole flow"});
     const auto found = std::find_if(p.solids.begin(), p.solids.end(),
                                     [&](const SolidEntry& s) { return s.name == b.valve_solid; });
@@ -1047,6 +1048,7 @@ class FsciProblem final : public run::Problem {
       if (result.converged) {
         if (quasi_newton_) quasi_newton_->end_step();
         fluid_.commit_step();
+        measure_swept_flow(step);
         for (auto& solid : solids_)
           if (solid->model) solid->model->commit();
         result.coupling.tries = attempt + 1;
@@ -1465,17 +1467,23 @@ class FsciProblem final : public run::Problem {
     valve_.opening.push_back(opening);
     valve_.closed.push_back(status.active > 0 ? 1 : 0);
     valve_.flow.push_back(fluid_.navier_stokes().boundary_flow(flow_tag_));
-    valve_.swept.push_back(swept_flow(solid));
+    valve_.swept.push_back(swept_flow_);
     valve_.max_penetration = std::max(valve_.max_penetration, status.max_penetration);
   }
 
-  /// The rate at which benchmark.upstream_surfaces of the valve's solid sweep the fluid on the
-  /// flow boundary's side: Σ ∫ v·n over them (n out of the solid). Collective.
-  double swept_flow(const Solid& solid) const {
-    double swept = 0;
-    for (const auto& group : parameters_.benchmark.upstream_surfaces)
-      swept += solid.model->surface_flux(group);
-    return swept;
+  /// The rate at which benchmark.upstream_surfaces of the valve's solid swept the fluid on the
+  /// flow boundary's side over the step just converged, before the solids' commit: the volume
+  /// they sweep from uₙ to uₙ₊₁ (n out of the solid) over Δt. Summed over a phase it is the
+  /// change of the volume they bound, whatever the leaflets' velocities do from step to step.
+  /// Collective.
+  void measure_swept_flow(double step) {
+    swept_flow_ = 0;
+    const auto& b = parameters_.benchmark;
+    if (b.type != "valve") return;
+    for (const auto& solid : solids_)
+      if (solid->model && solid->entry->name == b.valve_solid)
+        for (const auto& group : b.upstream_surfaces)
+          swept_flow_ += solid->model->surface_swept_volume(group) / step;
   }
 
   /// Closed phases (runs of steps with contact), in each the volume through flow_boundary
@@ -1796,9 +1804,10 @@ class FsciProblem final : public run::Problem {
   fluid::FluidModel fluid_;
   std::vector<std::unique_ptr<Solid>> solids_;
   std::unique_ptr<ConstraintGroup> group_;  ///< the solids' constraints together (after start)
-  long long n_constrained_ = 0;      ///< distinct constrained fluid vertices of the last solve
-  double force_balance_ = 0;         ///< max over solids of the relative force balance error
-  bool deformable_ = false;          ///< some solid is deformable: coupling iterations
+  long long n_constrained_ = 0;  ///< distinct constrained fluid vertices of the last solve
+  double force_balance_ = 0;     ///< max over solids of the relative force balance error
+  double swept_flow_ = 0;    ///< the valve's swept flow over the last committed step (0: steady)
+  bool deformable_ = false;  ///< some solid is deformable: coupling iterations
   bool first_solve_failed_ = false;  ///< the last try failed in a solid's first solve of the step
   std::unique_ptr<InterfaceQuasiNewton> quasi_newton_;  ///< coupling.iteration.method iqn_ils
   int last_columns_ = 0;                                ///< columns of the last IQN-ILS update

@@ -616,46 +616,59 @@ class SolidModelImpl {
     return motions;
   }
 
-  double surface_flux(const std::string& boundary) const {
-    const int tag = facet_tag(boundary, "surface_flux");
+  double surface_swept_volume(const std::string& boundary) const {
+    const int tag = facet_tag(boundary, "surface_swept_volume");
+    fem::update_ghosts(u_committed_.get());
     fem::update_ghosts(u_.get());
-    fem::update_ghosts(v_.get());
-    fem::LocalValues displacement(u_.get()), velocity(v_.get());
-    const auto x = [&](int vertex, int i) {
-      const auto k = static_cast<std::size_t>(vertex) * static_cast<std::size_t>(dim_) +
-                     static_cast<std::size_t>(i);
-      return mesh_.coordinates[k] + displacement[k];
+    fem::LocalValues start(u_committed_.get()), end(u_.get());
+    const auto d = static_cast<std::size_t>(dim_);
+    // the point of vertex `vertex` at the fraction tau of the straight path from X + uₙ to X + u
+    const auto x = [&](int vertex, int i, double tau) {
+      const auto k = static_cast<std::size_t>(vertex) * d + static_cast<std::size_t>(i);
+      return mesh_.coordinates[k] + (1 - tau) * start[k] + tau * end[k];
     };
-    double flux = 0;
+    // |F| n at tau, n out of the body by the facets' orientation (mesh.hpp): the edge turned
+    // clockwise in 2D, half the cross product of two edges in 3D.
+    const auto area_normal = [&](const int* v, double tau, double* an) {
+      if (dim_ == 2) {
+        an[0] = x(v[1], 1, tau) - x(v[0], 1, tau);
+        an[1] = -(x(v[1], 0, tau) - x(v[0], 0, tau));
+        return;
+      }
+      double e1[3], e2[3];
+      for (int i = 0; i < 3; ++i) {
+        e1[i] = x(v[1], i, tau) - x(v[0], i, tau);
+        e2[i] = x(v[2], i, tau) - x(v[0], i, tau);
+      }
+      an[0] = 0.5 * (e1[1] * e2[2] - e1[2] * e2[1]);
+      an[1] = 0.5 * (e1[2] * e2[0] - e1[0] * e2[2]);
+      an[2] = 0.5 * (e1[0] * e2[1] - e1[1] * e2[0]);
+    };
+    double volume = 0;
     for (int f = 0; f < mesh_.n_facets(); ++f) {
       if (mesh_.facet_tags[f] != tag || mesh_.facet_cell[f] >= mesh_.n_owned_cells) continue;
-      const int* v = mesh_.facets.data() + static_cast<std::size_t>(f) * dim_;
-      // |F| n in the current configuration, n out of the body by the facets' orientation
-      // (mesh.hpp): the edge turned clockwise in 2D, half the cross product of two edges in 3D.
-      double area_normal[3] = {};
-      if (dim_ == 2) {
-        area_normal[0] = x(v[1], 1) - x(v[0], 1);
-        area_normal[1] = -(x(v[1], 0) - x(v[0], 0));
-      } else {
-        double e1[3], e2[3];
-        for (int i = 0; i < 3; ++i) {
-          e1[i] = x(v[1], i) - x(v[0], i);
-          e2[i] = x(v[2], i) - x(v[0], i);
-        }
-        area_normal[0] = 0.5 * (e1[1] * e2[2] - e1[2] * e2[1]);
-        area_normal[1] = 0.5 * (e1[2] * e2[0] - e1[0] * e2[2]);
-        area_normal[2] = 0.5 * (e1[0] * e2[1] - e1[1] * e2[0]);
-      }
-      // ∫_F v·n = |F| n · (mean of the vertex velocities): exact for P1 on a flat facet.
+      const int* v = mesh_.facets.data() + static_cast<std::size_t>(f) * d;
+      // Along the path every point of the facet moves by the P1 interpolant of the vertices'
+      // moves, constant in tau, and the facet stays flat, so ∫_F Δx·n da = (mean Δx)·|F|n(tau).
+      // |F|n is linear in tau in 2D and quadratic in 3D: the midpoint rule, resp. Simpson's
+      // rule, integrates it over tau ∈ [0, 1] exactly.
+      double mean_move[3] = {};
       for (int a = 0; a < dim_; ++a)
-        for (int i = 0; i < dim_; ++i)
-          flux += area_normal[i] *
-                  velocity[static_cast<std::size_t>(v[a]) * static_cast<std::size_t>(dim_) +
-                           static_cast<std::size_t>(i)] /
-                  dim_;
+        for (int i = 0; i < dim_; ++i) mean_move[i] += (x(v[a], i, 1.0) - x(v[a], i, 0.0)) / dim_;
+      double an[3] = {}, path[3] = {};
+      if (dim_ == 2) {
+        area_normal(v, 0.5, path);
+      } else {
+        constexpr double tau[] = {0.0, 0.5, 1.0}, weight[] = {1.0 / 6, 4.0 / 6, 1.0 / 6};
+        for (int q = 0; q < 3; ++q) {
+          area_normal(v, tau[q], an);
+          for (int i = 0; i < 3; ++i) path[i] += weight[q] * an[i];
+        }
+      }
+      for (int i = 0; i < dim_; ++i) volume += mean_move[i] * path[i];
     }
-    MPI_Allreduce(MPI_IN_PLACE, &flux, 1, MPI_DOUBLE, MPI_SUM, comm_);
-    return flux;
+    MPI_Allreduce(MPI_IN_PLACE, &volume, 1, MPI_DOUBLE, MPI_SUM, comm_);
+    return volume;
   }
 
   std::vector<double> current_coordinates() const {
@@ -1862,8 +1875,8 @@ std::array<double, 9> SolidModel::mean_cauchy_stress() const {
 std::vector<double> SolidModel::reaction_force(const std::string& boundary) const {
   return impl_->reaction_force(boundary);
 }
-double SolidModel::surface_flux(const std::string& boundary) const {
-  return impl_->surface_flux(boundary);
+double SolidModel::surface_swept_volume(const std::string& boundary) const {
+  return impl_->surface_swept_volume(boundary);
 }
 std::vector<double> SolidModel::current_coordinates() const {
   return impl_->current_coordinates();

@@ -223,11 +223,14 @@ class SolidModel {
   /// force the supports exert on the body, per unit thickness in 2D) [N], dim() components.
   /// InputError when the group does not exist. Collective.
   std::vector<double> reaction_force(const std::string& boundary) const;
-  /// The flux of the trial velocity through a boundary group in the current configuration,
-  /// ∫_Γ v·n da with n the outward normal of the body [m³/s, or m²/s in 2D]: the rate at which
-  /// that surface sweeps the space outside the body. InputError when the group does not
-  /// exist. Collective.
-  double surface_flux(const std::string& boundary) const;
+  /// The volume a boundary group sweeps as each of its points moves on a straight line from
+  /// the committed configuration X + uₙ to the trial one X + u, counted positive where it moves
+  /// along n, the outward normal of the body [m³, or m² in 2D]. Exact for P1 facets; over the
+  /// whole boundary it is the change of volume(). Divided by Δt it is the rate at which that
+  /// surface sweeps the space outside the body over the step, in step with the displacement
+  /// (the trial velocity's flux ∫ v·n da need not be: contact-stabilized Newmark corrects u
+  /// without v). InputError when the group does not exist. Collective.
+  double surface_swept_volume(const std::string& boundary) const;
   /// The current coordinates X + u of the local vertices (owned and ghost), row-major.
   std::vector<double> current_coordinates() const;
 
