@@ -12,8 +12,10 @@ level 0, with the pressure reversed from the start so that the leaflets close (t
    leak_flow is the outflow less that swept flow;
  - 2 ranks agree with 1 rank to the coupling tolerance (opening, flow and swept flow to 1e-3
    relative);
- - IQN-ILS needs fewer than half the coupling iterations of Aitken's relaxation over the
-   first 5 steps (the added-mass effect of leaflets barely heavier than the fluid);
+ - without the case's iteration inertia (coupling.iteration.iteration_density = 0), IQN-ILS
+   needs fewer than half the coupling iterations of Aitken's relaxation over the first 5 steps
+   (the added-mass effect of leaflets barely heavier than the fluid; measured 39 against 135;
+   with the case's 1000 kg/m^3, 29 against 50);
  - a valve benchmark naming a solid without contact is an input error naming the key, and so
    is an upstream surface the solid does not have."""
 
@@ -67,7 +69,9 @@ def main():
 
     iterations = {}
     for method in ("iqn_ils", "aitken"):
-        summary, _ = run(r, f"valve-{method}", 1, 0.01, ("--set", f"coupling.iteration.method={method}"))
+        options = ("--set", f"coupling.iteration.method={method}",
+                   "--set", "coupling.iteration.iteration_density=0")
+        summary, _ = run(r, f"valve-{method}", 1, 0.01, options)
         if summary is not None:
             iterations[method] = summary["iterations"]["coupling"]
     if len(iterations) == 2:
