@@ -1517,11 +1517,12 @@ class FsciProblem final : public run::Problem {
     json["max_penetration"] = valve_.max_penetration;
     json["max_opening"] = largest;
     json["min_opening"] = std::isfinite(smallest) ? smallest : 0.0;
-    log::info(
-        "valve: {} closed phase(s), leak volume {} (outflow {}) m^2 (2D) / m^3, opening in "
-        "[{:.4e}, {:.4e}] m, max penetration {:.3e} m",
-        leak.size(), fmt::join(leak, ", "), fmt::join(outflow, ", "),
-        json["min_opening"].as_double(), largest, valve_.max_penetration);
+    const std::string phases =
+        leak.empty() ? std::string("no closed phase")
+                     : fmt::format("{} closed phase(s), leak volume {} (outflow {}) m^2 (2D) / m^3",
+                                   leak.size(), fmt::join(leak, ", "), fmt::join(outflow, ", "));
+    log::info("valve: {}, opening in [{:.4e}, {:.4e}] m, max penetration {:.3e} m", phases,
+              json["min_opening"].as_double(), largest, valve_.max_penetration);
   }
 
   /// c = 2F/(ρŪ²D) of the benchmark body.
