@@ -11,6 +11,9 @@ contact-stabilized Newmark with mortar contact, IQN-ILS reusing the last 4 steps
   steps straight through: the fluid's BDF2 history, the leaflets' Newmark state, the applied
   force that starts a step, the constrained fluid nodes, the contact active set and the
   complementarity constant and the IQN-ILS columns all come back;
+- the same with `fluid.covered_continuity_factor: 0.01` (the covered cells, from the
+  constrained nodes and the walls, are found again after the restart): steps 21..22 bit for
+  bit;
 - restarted on 1 rank (another partition), step 22 agrees to 1e-5 relative in the opening and
   the inlet flow (the coupling stops at a relative change of 1e-3, so its iterates differ by
   round-off from the 2-rank run's);
@@ -91,6 +94,21 @@ def main():
         runner.expect(last["time"] == expected["time"] and worst < 1e-5,
                       f"restart on 1 rank: step 22 agrees to 1e-5 (largest relative difference "
                       f"{worst:.2e})")
+
+    # With the continuity of the covered cells scaled (fluid.covered_continuity_factor), whose
+    # cells come from the constrained nodes and the walls, the restart is bit for bit too.
+    factor = ["--set", "fluid.covered_continuity_factor=0.01"]
+    runs = {"straight-k": run("straight-k", 0.044, *factor), "first-k": run("first-k", 0.040, *factor)}
+    runs["again-k"] = run("again-k", 0.044, *factor, "--restart", work / "first-k")
+    runner.expect(all(result.returncode == 0 for result in runs.values()),
+                  "valve runs with covered_continuity_factor succeed",
+                  "\n".join(result.stderr[-2000:] for result in runs.values()))
+    if all(result.returncode == 0 for result in runs.values()):
+        reference_k = read_rows(work / "straight-k" / "series.csv")
+        runner.expect(len(reference_k) == 22 and int(float(reference_k[19]["contact_active_nodes_leaflets"])) > 0
+                      and read_rows(work / "again-k" / "series.csv") == reference_k[20:],
+                      "covered_continuity_factor 0.01: in contact at step 20, steps 21..22 restarted "
+                      "bit for bit as the straight run")
 
     # A step of the leaflets that fails keeps the last good state, all of it: the pressure
     # jumps to -1000 (in units of the case's 20 Pa) over step 21, whose coupling does not

@@ -20,6 +20,9 @@
 //    weight gives the constraint's velocities and reactions (NavierStokes::set_velocity_penalty);
 //    the penalty's stiffness κ follows 1/Δt by default and is the same for every Δt with a
 //    time scale τ (coupling.partial_time_scale).
+//  - fluid.covered_continuity_factor κ: the leak through a band held at rest across a channel
+//    is the band's PSPG flux, κ times the unscaled one (its resistance affine in 1/κ), with
+//    the band's pressure between the ends'.
 
 #include <gtest/gtest.h>
 #include <petscvec.h>
@@ -543,6 +546,75 @@ TEST(CouplingConstraint, PenaltyTimeScaleFixesItsStiffness) {
   EXPECT_LT(fixed_change, 1e-9);
   EXPECT_GT(own_ratio_low, 1.5);  // nearly 2: the viscous part does not change
   EXPECT_LT(own_ratio_high, 2.0 + 1e-9);
+}
+
+/// The channel [0, 2] × [0, 1] (h = 0.05) driven by a pressure of 1 at its left end and closed
+/// by a band 0.95 ≤ x ≤ 1.05 of vertices held at rest (as a closed valve's leaflets are, the
+/// wall vertices left to their no-slip condition), steady, with the continuity equation of the
+/// band's cells scaled by `factor` (fluid.covered_continuity_factor). Returns the flow out at
+/// the right end and the band's pressure range (min, max).
+struct ClosedBand {
+  double leak = 0, band_min = 0, band_max = 0;
+};
+ClosedBand closed_band(double factor) {
+  const std::string text = R"(
+mesh: {type: rectangle, lower: [0, 0], upper: [2, 1], cells: [40, 20]}
+fluid: {density: 1.0, viscosity: 0.01, covered_continuity_factor: )" +
+                           std::to_string(factor) + R"(}
+boundary:
+  - {group: bottom, type: no_slip}
+  - {group: top, type: no_slip}
+outlets:
+  - {group: left, type: traction, pressure: 1.0, backflow: 0}
+  - {group: right, type: do_nothing, backflow: 0}
+)";
+  auto document = coapt::config::Document::from_string(text, "closed_band.yaml");
+  const auto root = document.root();
+  FluidModel fluid(FluidCase::read(root, root.section("fluid")), kWorld);
+  const Mesh& mesh = fluid.mesh();
+  std::vector<int> band;
+  for (int v = 0; v < mesh.n_owned_vertices; ++v) {
+    const auto x = mesh.point(v);
+    if (x[0] > 0.94 && x[0] < 1.06 && x[1] > 1e-9 && x[1] < 1 - 1e-9) band.push_back(v);
+  }
+  fluid.start(0.0);
+  fluid.set_velocity_constraint(band, std::vector<double>(2 * band.size(), 0.0));
+  fluid.solve_steady("closed band");
+  ClosedBand result;
+  result.leak = fluid.outlet_flow(1);
+  coapt::fem::LocalValues state(fluid.state());
+  double low = 1e300, high = -1e300;
+  for (const int v : band) {
+    low = std::min(low, state[3 * static_cast<std::size_t>(v) + 2]);
+    high = std::max(high, state[3 * static_cast<std::size_t>(v) + 2]);
+  }
+  MPI_Allreduce(&low, &result.band_min, 1, MPI_DOUBLE, MPI_MIN, kWorld);
+  MPI_Allreduce(&high, &result.band_max, 1, MPI_DOUBLE, MPI_MAX, kWorld);
+  return result;
+}
+
+TEST(CouplingConstraint, CoveredContinuityFactorScalesTheLeakThroughAClosedBand) {
+  // Through a band held at rest the flow passes only as the PSPG flux τ_M ∇p of the band's
+  // cells: scaling their continuity equation by κ scales that flux by κ, so the resistance to
+  // the leak, Δp/Q, is R_outside + R_band/κ (affine in 1/κ): its steps from κ = 1 to 0.1 and
+  // from 0.1 to 0.01 are in the ratio (100 − 10)/(10 − 1) = 10. The band's pressure stays
+  // between the ends' (0 and 1).
+  const ClosedBand full = closed_band(1.0), tenth = closed_band(0.1), hundredth = closed_band(0.01);
+  const double first_step = 1 / tenth.leak - 1 / full.leak,
+               second_step = 1 / hundredth.leak - 1 / tenth.leak;
+  if (coapt::rank_of(kWorld) == 0)
+    std::printf(
+        "closed band: leak %.6e (1), %.6e (0.1), %.6e (0.01); resistance steps %.4f, %.4f "
+        "(ratio %.4f); pressure in the band [%.4f, %.4f] (0.01)\n",
+        full.leak, tenth.leak, hundredth.leak, first_step, second_step, second_step / first_step,
+        hundredth.band_min, hundredth.band_max);
+  EXPECT_GT(full.leak, 0.0);
+  EXPECT_LT(tenth.leak, 0.2 * full.leak);
+  EXPECT_NEAR(second_step / first_step, 10.0, 0.2);
+  for (const auto& band : {full, tenth, hundredth}) {
+    EXPECT_GT(band.band_min, 0.0);
+    EXPECT_LT(band.band_max, 1.0);
+  }
 }
 
 }  // namespace

@@ -146,6 +146,15 @@ FluidCase FluidCase::read(const config::Section& section, const config::Section&
        "include (2/Δt)² in τ_M (transient runs); false: τ_M from the convective and viscous "
        "terms only, so that the stabilisation does not fade as Δt → 0 (time-step studies, "
        "very small steps)"});
+  p.fluid.covered_continuity_factor = fluid.get<double>(
+      "covered_continuity_factor", 1.0,
+      {"",
+       "factor on the continuity equation (its Galerkin and PSPG parts) in the cells whose "
+       "vertices all carry an immersed solid's velocity constraint (or a wall's velocity "
+       "condition, one at least the solid's), where the fluid is fictitious: below 1 it "
+       "narrows the PSPG flux through a closed valve's leaflets (docs/verification/fsci.md); "
+       "1: the same equation everywhere",
+       Bounds{0.0, 1.0, true, false}});
   auto newton = fluid.section("newton", "Newton's method per step");
   p.fluid.newton_relative_tolerance = newton.get<double>(
       "relative_tolerance", 1e-8, {"", "stop when ‖R‖ ≤ rtol ‖R₀‖", Bounds::open(0, 1)});
@@ -386,9 +395,13 @@ void FluidModel::describe(const std::string& title) const {
       mesh_.n_global_cells, mesh_.n_global_vertices, mesh_.dim, size_of(comm_), quality_.min_shape,
       quality_.max_shape);
   log::info(
-      "fluid: rho = {:g} kg/m^3, mu = {:g} Pa s, C_I = {:g}{}, {}, {} form of the viscous term",
+      "fluid: rho = {:g} kg/m^3, mu = {:g} Pa s, C_I = {:g}{}{}, {}, {} form of the viscous term",
       parameters_.fluid.density, parameters_.fluid.viscosity, parameters_.fluid.c_inverse,
       parameters_.fluid.tau_time_term ? "" : " (tau_M without the time term)",
+      parameters_.fluid.covered_continuity_factor == 1.0
+          ? std::string()
+          : fmt::format(", continuity x {:g} in covered cells",
+                        parameters_.fluid.covered_continuity_factor),
       parameters_.fluid.convection ? "Navier-Stokes" : "Stokes",
       parameters_.fluid.viscous_form == ViscousForm::stress ? "stress" : "Laplace");
 }

@@ -300,6 +300,27 @@ void NavierStokes::set_velocity_constraint(std::span<const int> vertices,
   COAPT_PETSC_CHECK(VecAssemblyBegin(state_));
   COAPT_PETSC_CHECK(VecAssemblyEnd(state_));
   fem::update_ghosts(state_);
+  if (parameters_.covered_continuity_factor == 1.0) return;
+  // Per vertex 2: constrained, 1: all its velocity dofs Dirichlet (a wall inside the solid's
+  // region), 0: free; the ghost vertices' flags come from their owners.
+  auto flags = fem::create_vertex_vector(mesh_, 1);
+  for (int v = 0; v < mesh_.n_owned_vertices; ++v) {
+    bool fixed = true;
+    for (int i = 0; i < dim && fixed; ++i)
+      fixed = std::binary_search(dirichlet_dofs_.begin(), dirichlet_dofs_.end(),
+                                 static_cast<PetscInt>(mesh_.global_vertex[v] * n + i));
+    if (fixed) COAPT_PETSC_CHECK(VecSetValue(flags, mesh_.global_vertex[v], 1.0, INSERT_VALUES));
+  }
+  for (const int v : vertices)
+    COAPT_PETSC_CHECK(VecSetValue(flags, mesh_.global_vertex[v], 2.0, INSERT_VALUES));
+  COAPT_PETSC_CHECK(VecAssemblyBegin(flags));
+  COAPT_PETSC_CHECK(VecAssemblyEnd(flags));
+  fem::update_ghosts(flags);
+  fem::LocalValues local(flags);
+  const auto values = local.values();
+  constrained_vertex_flag_.assign(values.size(), 0);
+  for (std::size_t v = 0; v < values.size(); ++v)
+    constrained_vertex_flag_[v] = static_cast<char>(std::lround(values[v]));
 }
 
 void NavierStokes::set_velocity_penalty(std::span<const int> vertices,
@@ -620,6 +641,20 @@ void NavierStokes::assemble(const TimeLevel& time, bool with_matrix) {
     set_stabilisation<Dim>(data, mean, parameters_.tau_time_term ? time.time_step : 0.0,
                            parameters_.c_inverse);
   };
+  // The factor on local cell c's continuity rows: covered_continuity_factor if its vertices
+  // all carry the velocity constraint or have Dirichlet velocities, at least one the
+  // constraint; else 1.
+  auto continuity_factor = [&](int c) {
+    if (constrained_vertex_flag_.empty()) return 1.0;
+    const auto vertices = mesh_.cell(c);
+    bool constrained = false;
+    for (int a = 0; a < n; ++a) {
+      const char flag = constrained_vertex_flag_[vertices[a]];
+      if (flag == 0) return 1.0;
+      constrained = constrained || flag == 2;
+    }
+    return constrained ? parameters_.covered_continuity_factor : 1.0;
+  };
   // The backflow facets of local cell c, unpacked from set_outlets' layout.
   auto backflow_facets = [&](int c, auto&& use) {
     if (backflow_offsets_.empty()) return;
@@ -641,6 +676,8 @@ void NavierStokes::assemble(const TimeLevel& time, bool with_matrix) {
     double x[m];
     element(c, data, x);
     element_residual<Dim, double>(data, x, r);
+    if (const double factor = continuity_factor(c); factor != 1.0)
+      for (int a = 0; a < n; ++a) r[a * n + Dim] *= factor;
     backflow_facets(c, [&](const OutletFacet<Dim>& facet) {
       backflow_facet_residual<Dim, double>(facet, x, r);
     });
@@ -652,6 +689,9 @@ void NavierStokes::assemble(const TimeLevel& time, bool with_matrix) {
       double x[m];
       element(c, data, x);
       element_residual_and_jacobian<Dim>(data, x, nullptr, K);
+      if (const double factor = continuity_factor(c); factor != 1.0)
+        for (int a = 0; a < n; ++a)
+          for (int col = 0; col < m; ++col) K[(a * n + Dim) * m + col] *= factor;
       backflow_facets(c, [&](const OutletFacet<Dim>& facet) {
         backflow_facet_residual_and_jacobian<Dim>(facet, x, nullptr, K);
       });

@@ -35,6 +35,10 @@ struct FluidParameters {
   double c_inverse = 9.0;                           ///< C_I of τ_M (kernels.hpp)
   /// τ_M includes (2/Δt)² (false: only the convective and viscous terms, independent of Δt)
   bool tau_time_term = true;
+  /// Factor on the continuity residual (Galerkin and PSPG) of the cells whose vertices all
+  /// carry the velocity constraint or Dirichlet velocities, one at least the constraint (inside
+  /// an immersed solid). 1: no change.
+  double covered_continuity_factor = 1.0;
   double newton_relative_tolerance = 1e-8;   ///< ‖R‖ ≤ rtol ‖R₀‖ ...
   double newton_absolute_tolerance = 1e-10;  ///< ... or ‖R‖ ≤ atol
   int newton_max_iterations = 25;
@@ -207,6 +211,9 @@ class NavierStokes {
   fem::LinearSolver solver_;
   std::vector<PetscInt> dirichlet_dofs_;
   std::vector<int> constrained_vertices_;
+  /// Per local vertex (owned and ghost): 2 carries the velocity constraint, 1 has Dirichlet
+  /// velocities, 0 free (set only when covered_continuity_factor ≠ 1).
+  std::vector<char> constrained_vertex_flag_;
   /// The velocity penalty: owned local vertices, weights, targets (dim each), and per owned
   /// vertex ∫φ_v and ∫|∇φ_v|² (computed on the first penalty).
   std::vector<int> penalty_vertices_;
