@@ -93,6 +93,9 @@ struct Benchmark {
   /// valve: the solid's boundary groups that face flow_boundary's side of the closed valve;
   /// their swept flux is taken from the flow to give the leak (empty: the flow is the leak)
   std::vector<std::string> upstream_surfaces;
+  /// valve: the fluid boundary group on the other side of the closed valve (empty: none); the
+  /// leak is measured again there, from the solid's change of volume and that group's flow
+  std::string downstream_boundary;
   double reference_drag = 0, reference_lift = 0, reference_pressure_difference = 0;
 };
 
@@ -280,6 +283,14 @@ Parameters read(const config::Section& root) {
          "dt) is taken from the flow, so that the leak excludes the fluid the moving leaflets "
          "push out; "
          "empty: the leak is the whole flow"});
+    b.downstream_boundary = benchmark.get<std::string>(
+        "downstream_boundary", "",
+        {"",
+         "fluid boundary group on the other side of the closed valve: the leak is measured "
+         "there too (leak_flow_downstream: the solid's rate of change of volume less the "
+         "upstream surfaces' swept flow, less the flow out through this group); the two "
+         "measures differ by the fluid's net outflow less the solid's rate of change of volume, "
+         "a check of the discrete mass balance; empty: none"});
     const auto found = std::find_if(p.solids.begin(), p.solids.end(),
                                     [&](const SolidEntry& s) { return s.name == b.valve_solid; });
     if (found == p.solids.end() || !found->contact.enabled())
@@ -518,6 +529,9 @@ class FsciProblem final : public run::Problem {
       boundary_tags_.push_back(fluid_.boundary_tag(group, "benchmark.boundaries"));
     if (b.type == "valve") {
       flow_tag_ = fluid_.boundary_tag(b.flow_boundary, "benchmark.flow_boundary");
+      if (!b.downstream_boundary.empty())
+        downstream_tag_ =
+            fluid_.boundary_tag(b.downstream_boundary, "benchmark.downstream_boundary");
       const auto& solid_mesh = find_solid(b.valve_solid)->mesh;
       for (const auto& group : b.upstream_surfaces) {
         const auto* found = solid_mesh.find_group(group);
@@ -687,6 +701,7 @@ class FsciProblem final : public run::Problem {
         step = n_steps_done = read_checkpoint(*restart_);
         log::info("continuing after step {} (t = {:g} s)", step, fluid_.time());
       }
+      start_valve_volume();
       Progress progress(p.time.n_steps(), p.time.end_time, fluid_.time());
       while (fluid_.time() < p.time.end_time * (1 - 1e-12)) {
         const double dt = p.time.step_from(fluid_.time());
@@ -797,6 +812,8 @@ class FsciProblem final : public run::Problem {
     valve["opening"] = io::Json::array_of(valve_.opening);
     valve["flow"] = io::Json::array_of(valve_.flow);
     valve["swept"] = io::Json::array_of(valve_.swept);
+    valve["downstream_flow"] = io::Json::array_of(valve_.downstream_flow);
+    valve["volume_rate"] = io::Json::array_of(valve_.volume_rate);
     valve["closed"] =
         io::Json::array_of(std::vector<int>(valve_.closed.begin(), valve_.closed.end()));
     valve["max_penetration"] = valve_.max_penetration;
@@ -864,6 +881,18 @@ class FsciProblem final : public run::Problem {
     // absent from checkpoints written before it: no swept flow
     valve_.swept = valve.contains("swept") ? doubles(valve.at("swept"))
                                            : std::vector<double>(valve_.flow.size(), 0.0);
+    if (valve.contains("volume_rate")) {
+      valve_.downstream_flow = doubles(valve.at("downstream_flow"));
+      valve_.volume_rate = doubles(valve.at("volume_rate"));
+    } else {
+      // written before the downstream measure: its steps add nothing to it
+      valve_.downstream_flow.assign(valve_.flow.size(), 0.0);
+      valve_.volume_rate = valve_.swept;
+      if (downstream_tag_ >= 0 && !valve_.flow.empty())
+        log::warn(
+            "--restart: the checkpoint predates benchmark.downstream_boundary: the leak "
+            "measured downstream counts the steps after the restart only");
+    }
     for (const auto& value : valve.at("closed").as_array())
       valve_.closed.push_back(value.as_int() != 0 ? 1 : 0);
     valve_.max_penetration = valve.at("max_penetration").as_double();
@@ -1468,6 +1497,9 @@ class FsciProblem final : public run::Problem {
     valve_.closed.push_back(status.active > 0 ? 1 : 0);
     valve_.flow.push_back(fluid_.navier_stokes().boundary_flow(flow_tag_));
     valve_.swept.push_back(swept_flow_);
+    valve_.downstream_flow.push_back(
+        downstream_tag_ >= 0 ? fluid_.navier_stokes().boundary_flow(downstream_tag_) : 0.0);
+    valve_.volume_rate.push_back(volume_rate_);
     valve_.max_penetration = std::max(valve_.max_penetration, status.max_penetration);
   }
 
@@ -1478,19 +1510,34 @@ class FsciProblem final : public run::Problem {
   /// Collective.
   void measure_swept_flow(double step) {
     swept_flow_ = 0;
+    volume_rate_ = 0;
+    const auto& b = parameters_.benchmark;
+    if (b.type != "valve") return;
+    for (const auto& solid : solids_)
+      if (solid->model && solid->entry->name == b.valve_solid) {
+        for (const auto& group : b.upstream_surfaces)
+          swept_flow_ += solid->model->surface_swept_volume(group) / step;
+        const double volume = solid->model->volume();
+        volume_rate_ = (volume - valve_volume_) / step;
+        valve_volume_ = volume;
+      }
+  }
+
+  /// The valve's solid's volume at the committed state (at the start of a run or restart).
+  /// Collective.
+  void start_valve_volume() {
     const auto& b = parameters_.benchmark;
     if (b.type != "valve") return;
     for (const auto& solid : solids_)
       if (solid->model && solid->entry->name == b.valve_solid)
-        for (const auto& group : b.upstream_surfaces)
-          swept_flow_ += solid->model->surface_swept_volume(group) / step;
+        valve_volume_ = solid->model->volume();
   }
 
   /// Closed phases (runs of steps with contact), in each the volume through flow_boundary
   /// (Σ Q Δt over its steps) and the leak (Σ (Q − swept) Δt), the extremes of the opening and
   /// the largest penetration.
   void valve_benchmark(io::Json& json) const {
-    std::vector<double> leak, outflow, phase_start, phase_end;
+    std::vector<double> leak, leak_downstream, outflow, phase_start, phase_end;
     double largest = 0, smallest = std::numeric_limits<double>::infinity();
     for (std::size_t k = 0; k < valve_.times.size(); ++k) {
       if (std::isfinite(valve_.opening[k])) {
@@ -1501,11 +1548,13 @@ class FsciProblem final : public run::Problem {
       const double dt = k > 0 ? valve_.times[k] - valve_.times[k - 1] : 0.0;
       if (k == 0 || !valve_.closed[k - 1]) {
         leak.push_back(0.0);
+        leak_downstream.push_back(0.0);
         outflow.push_back(0.0);
         phase_start.push_back(valve_.times[k]);
         phase_end.push_back(valve_.times[k]);
       }
       leak.back() += (valve_.flow[k] - valve_.swept[k]) * dt;
+      leak_downstream.back() += valve_.downstream_leak(k) * dt;
       outflow.back() += valve_.flow[k] * dt;
       phase_end.back() = valve_.times[k];
     }
@@ -1514,6 +1563,7 @@ class FsciProblem final : public run::Problem {
     json["closed_phase_end"] = io::Json::array_of(phase_end);
     json["leak_volume"] = io::Json::array_of(leak);
     json["outflow_volume"] = io::Json::array_of(outflow);
+    if (downstream_tag_ >= 0) json["leak_volume_downstream"] = io::Json::array_of(leak_downstream);
     json["max_penetration"] = valve_.max_penetration;
     json["max_opening"] = largest;
     json["min_opening"] = std::isfinite(smallest) ? smallest : 0.0;
@@ -1523,6 +1573,9 @@ class FsciProblem final : public run::Problem {
                                    leak.size(), fmt::join(leak, ", "), fmt::join(outflow, ", "));
     log::info("valve: {}, opening in [{:.4e}, {:.4e}] m, max penetration {:.3e} m", phases,
               json["min_opening"].as_double(), largest, valve_.max_penetration);
+    if (downstream_tag_ >= 0 && !leak.empty())
+      log::info("valve: leak volume measured downstream {} m^2 (2D) / m^3",
+                fmt::join(leak_downstream, ", "));
   }
 
   /// c = 2F/(ρŪ²D) of the benchmark body.
@@ -1590,6 +1643,8 @@ class FsciProblem final : public run::Problem {
       record_valve(time, opening, *solid);
       series.add("swept_flow", valve_.swept.back());
       series.add("leak_flow", valve_.flow.back() - valve_.swept.back());
+      if (downstream_tag_ >= 0)
+        series.add("leak_flow_downstream", valve_.downstream_leak(valve_.times.size() - 1));
     }
     if (parameters_.benchmark.type == "forces") {
       const auto force = benchmark_force();
@@ -1808,15 +1863,27 @@ class FsciProblem final : public run::Problem {
   long long n_constrained_ = 0;  ///< distinct constrained fluid vertices of the last solve
   double force_balance_ = 0;     ///< max over solids of the relative force balance error
   double swept_flow_ = 0;    ///< the valve's swept flow over the last committed step (0: steady)
+  double volume_rate_ = 0;   ///< the valve solid's change of volume over that step, over Δt
+  double valve_volume_ = 0;  ///< the valve solid's volume at the last commit
   bool deformable_ = false;  ///< some solid is deformable: coupling iterations
   bool first_solve_failed_ = false;  ///< the last try failed in a solid's first solve of the step
   std::unique_ptr<InterfaceQuasiNewton> quasi_newton_;  ///< coupling.iteration.method iqn_ils
   int last_columns_ = 0;                                ///< columns of the last IQN-ILS update
   std::vector<int> boundary_tags_;                      ///< benchmark.boundaries
   int flow_tag_ = -1;                                   ///< benchmark.flow_boundary (valve)
+  int downstream_tag_ = -1;  ///< benchmark.downstream_boundary (valve; -1: none)
   struct ValveHistory {
     std::vector<double> times, opening, flow;
     std::vector<double> swept;  ///< the upstream surfaces' swept flow (0 without them)
+    /// the flow out through the downstream boundary (0 without it) and the solid's rate of
+    /// change of volume: the leak measured downstream is volume_rate − swept − downstream_flow
+    std::vector<double> downstream_flow, volume_rate;
+    /// The leak across the valve towards flow_boundary at record k, measured on the other
+    /// side: the fluid there loses the volume the solid's boundary less its upstream surfaces
+    /// sweeps into it, and what flows out through the downstream boundary.
+    double downstream_leak(std::size_t k) const {
+      return volume_rate[k] - swept[k] - downstream_flow[k];
+    }
     std::vector<char> closed;
     double max_penetration = 0;
   } valve_;
