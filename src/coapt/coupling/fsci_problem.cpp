@@ -1513,24 +1513,19 @@ class FsciProblem final : public run::Problem {
     volume_rate_ = 0;
     const auto& b = parameters_.benchmark;
     if (b.type != "valve") return;
-    for (const auto& solid : solids_)
-      if (solid->model && solid->entry->name == b.valve_solid) {
-        for (const auto& group : b.upstream_surfaces)
-          swept_flow_ += solid->model->surface_swept_volume(group) / step;
-        const double volume = solid->model->volume();
-        volume_rate_ = (volume - valve_volume_) / step;
-        valve_volume_ = volume;
-      }
+    const auto& model = *find_solid(b.valve_solid)->model;  // deformable: it has contact
+    for (const auto& group : b.upstream_surfaces)
+      swept_flow_ += model.surface_swept_volume(group) / step;
+    const double volume = model.volume();
+    volume_rate_ = (volume - valve_volume_) / step;
+    valve_volume_ = volume;
   }
 
   /// The valve's solid's volume at the committed state (at the start of a run or restart).
   /// Collective.
   void start_valve_volume() {
     const auto& b = parameters_.benchmark;
-    if (b.type != "valve") return;
-    for (const auto& solid : solids_)
-      if (solid->model && solid->entry->name == b.valve_solid)
-        valve_volume_ = solid->model->volume();
+    if (b.type == "valve") valve_volume_ = find_solid(b.valve_solid)->model->volume();
   }
 
   /// Closed phases (runs of steps with contact), in each the volume through flow_boundary
