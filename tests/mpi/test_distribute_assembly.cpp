@@ -103,6 +103,29 @@ TEST_P(Distribution, GhostUpdateBringsOwnersValues) {
       EXPECT_EQ(local[2 * v + i], 10.0 * static_cast<double>(mesh.global_vertex[v]) + i);
 }
 
+TEST_P(Distribution, CellGhostUpdateBringsOwnersValues) {
+  // Owned cells numbered rank by rank (contiguous, matching a PETSc layout), and a ghost cell
+  // receives its owner's value: the owner's original cell number is this cell's.
+  for (const Mesh& mesh : {distributed_box(GetParam()), distributed_square(GetParam())}) {
+    ASSERT_EQ(mesh.global_cell.size(), static_cast<std::size_t>(mesh.n_cells()));
+    PetscInt offset = 0, n_owned = mesh.n_owned_cells;
+    MPI_Exscan(&n_owned, &offset, 1, MPIU_INT, MPI_SUM, MPI_COMM_WORLD);
+    if (coapt::rank_of(MPI_COMM_WORLD) == 0) offset = 0;
+    for (int c = 0; c < mesh.n_owned_cells; ++c) EXPECT_EQ(mesh.global_cell[c], offset + c);
+    auto vector = coapt::fem::create_cell_vector(mesh);
+    PetscScalar* data = nullptr;
+    VecGetArray(vector, &data);
+    for (int c = 0; c < mesh.n_owned_cells; ++c)
+      data[c] = static_cast<double>(mesh.original_cell[c]);
+    VecRestoreArray(vector, &data);
+    coapt::fem::update_ghosts(vector);
+    coapt::fem::LocalValues local(vector);
+    ASSERT_EQ(local.values().size(), static_cast<std::size_t>(mesh.n_cells()));
+    for (int c = 0; c < mesh.n_cells(); ++c)
+      EXPECT_EQ(local[c], static_cast<double>(mesh.original_cell[c]));
+  }
+}
+
 TEST_P(Distribution, CsrAssemblyEqualsPlainAssembly) {
   const Mesh mesh = distributed_box(GetParam());
   for (int n : {1, 3}) {

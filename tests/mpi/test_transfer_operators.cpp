@@ -126,6 +126,7 @@ Entries entries_by_original(const VariationalTransfer& t, const Mesh& slave, con
 /// Partition-independent figures of a transfer.
 struct Figures {
   double sum = 0, frobenius = 0, d_sum = 0, linear_error = 0;
+  double cell_covered = 0;  ///< Σ over the owned slave cells of |T| × its covered fraction
   PetscInt constrained = 0;
   std::int64_t pairs = 0;
 };
@@ -157,6 +158,9 @@ Figures figures_of(const VariationalTransfer& t, const Mesh& slave, const Mesh& 
   MPI_Allreduce(MPI_IN_PLACE, &f.linear_error, 1, MPI_DOUBLE, MPI_MAX, slave.comm);
   f.pairs = t.statistics().intersecting_pairs;
   MPI_Allreduce(MPI_IN_PLACE, &f.pairs, 1, MPI_INT64_T, MPI_SUM, slave.comm);
+  for (int c = 0; c < slave.n_owned_cells; ++c)
+    f.cell_covered += t.cell_coverage()[c] * std::fabs(coapt::mesh::cell_signed_measure(slave, c));
+  MPI_Allreduce(MPI_IN_PLACE, &f.cell_covered, 1, MPI_DOUBLE, MPI_SUM, slave.comm);
   return f;
 }
 
@@ -176,6 +180,7 @@ TEST(TransferOperatorsParallel, IndependentPartitionsGiveTheSerialOperators) {
 
     EXPECT_NEAR(f.sum, reference.sum, 1e-12 * reference.sum);
     EXPECT_NEAR(f.d_sum, reference.sum, 1e-12 * reference.sum);
+    EXPECT_NEAR(f.cell_covered, reference.sum, 1e-12 * reference.sum);  // each cell once
     EXPECT_NEAR(f.frobenius, reference.frobenius, 1e-12 * reference.frobenius);
     EXPECT_EQ(f.constrained, reference.constrained);
     EXPECT_GT(f.constrained, 0);

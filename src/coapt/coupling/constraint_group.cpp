@@ -122,4 +122,13 @@ std::vector<double> ConstraintGroup::reactions_of(std::size_t k,
   return own;
 }
 
+std::vector<double> ConstraintGroup::cell_coverage() const {
+  std::vector<double> sum(static_cast<std::size_t>(fluid_.n_owned_cells), 0.0);
+  for (const auto* constraint : constraints_) {
+    const auto& own = constraint->transfer().cell_coverage();
+    for (std::size_t c = 0; c < sum.size(); ++c) sum[c] += own[c];
+  }
+  return sum;
+}
+
 }  // namespace coapt::coupling

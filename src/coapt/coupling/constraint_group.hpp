@@ -69,6 +69,9 @@ class ConstraintGroup {
   /// From the reactions at the merged vertices of the last merge(): those at solid k's
   /// constrained vertices, in their order (each shared node's whole reaction r_i).
   std::vector<double> reactions_of(std::size_t k, const std::vector<double>& reactions) const;
+  /// Per owned fluid cell: the fraction of it the solids cover, Σ_k |T ∩ M_k| / |T| (above 1
+  /// where solids overlap; transfer::VariationalTransfer::cell_coverage).
+  std::vector<double> cell_coverage() const;
 
  private:
   const mesh::Mesh& fluid_;

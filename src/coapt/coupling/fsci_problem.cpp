@@ -1427,7 +1427,7 @@ class FsciProblem final : public run::Problem {
       }
     }
     const auto merged = group_->merge(shares);
-    fluid_.set_velocity_constraint(merged.vertices, merged.velocities);
+    fluid_.set_velocity_constraint(merged.vertices, merged.velocities, group_->cell_coverage());
     // partial coverage: each solid's penalty entries, one after the other
     std::vector<int> vertices;
     std::vector<double> weights, targets;

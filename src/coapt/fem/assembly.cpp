@@ -19,6 +19,21 @@ OwnedVec create_vertex_vector(const mesh::Mesh& mesh, int n_components) {
   return vector;
 }
 
+OwnedVec create_cell_vector(const mesh::Mesh& mesh) {
+  std::vector<PetscInt> ghosts;
+  if (!mesh.global_cell.empty())
+    ghosts.assign(mesh.global_cell.begin() + mesh.n_owned_cells, mesh.global_cell.end());
+  else if (mesh.n_owned_cells != mesh.n_cells())
+    throw InternalError("create_cell_vector: mesh '" + mesh.source +
+                        "' has ghost cells but no global cell numbers");
+  OwnedVec vector;
+  COAPT_PETSC_CHECK(VecCreateGhost(mesh.comm, mesh.n_owned_cells, PETSC_DECIDE,
+                                   static_cast<PetscInt>(ghosts.size()), ghosts.data(),
+                                   vector.out()));
+  COAPT_PETSC_CHECK(VecSet(vector, 0.0));
+  return vector;
+}
+
 void update_ghosts(Vec vector) {
   COAPT_PETSC_CHECK(VecGhostUpdateBegin(vector, INSERT_VALUES, SCATTER_FORWARD));
   COAPT_PETSC_CHECK(VecGhostUpdateEnd(vector, INSERT_VALUES, SCATTER_FORWARD));

@@ -23,6 +23,10 @@ namespace coapt::fem {
 /// local form is ordered as the mesh's local vertices (owned, then ghosts). Collective.
 OwnedVec create_vertex_vector(const mesh::Mesh& mesh, int n_components);
 
+/// A ghosted PETSc vector with one entry per cell of `mesh`; its local form is ordered as the
+/// mesh's local cells (owned, then ghosts; mesh::Mesh::global_cell). Collective.
+OwnedVec create_cell_vector(const mesh::Mesh& mesh);
+
 /// Refreshes the ghost entries of a vector from create_vertex_vector. Collective.
 void update_ghosts(Vec vector);
 

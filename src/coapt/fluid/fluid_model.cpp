@@ -155,6 +155,14 @@ FluidCase FluidCase::read(const config::Section& section, const config::Section&
        "narrows the PSPG flux through a closed valve's leaflets (docs/verification/fsci.md); "
        "1: the same equation everywhere",
        Bounds{0.0, 1.0, true, false}});
+  p.fluid.covered_continuity_coverage = fluid.get<double>(
+      "covered_continuity_coverage", p.fluid.covered_continuity_coverage,
+      {"",
+       "covered_continuity_factor applies only to the cells of which the solids cover at "
+       "least this fraction: a cell partly outside them (one spanning the gap between two "
+       "leaflets as they close) holds real fluid and keeps its whole continuity equation, so "
+       "that the fluid's mass balance stays exact there; 0: the vertex rule alone",
+       Bounds::closed(0.0, 1.0)});
   auto newton = fluid.section("newton", "Newton's method per step");
   p.fluid.newton_relative_tolerance = newton.get<double>(
       "relative_tolerance", 1e-8, {"", "stop when ‖R‖ ≤ rtol ‖R₀‖", Bounds::open(0, 1)});
@@ -400,8 +408,9 @@ void FluidModel::describe(const std::string& title) const {
       parameters_.fluid.tau_time_term ? "" : " (tau_M without the time term)",
       parameters_.fluid.covered_continuity_factor == 1.0
           ? std::string()
-          : fmt::format(", continuity x {:g} in covered cells",
-                        parameters_.fluid.covered_continuity_factor),
+          : fmt::format(", continuity x {:g} in the cells the solids cover ({:g} of the cell)",
+                        parameters_.fluid.covered_continuity_factor,
+                        parameters_.fluid.covered_continuity_coverage),
       parameters_.fluid.convection ? "Navier-Stokes" : "Stokes",
       parameters_.fluid.viscous_form == ViscousForm::stress ? "stress" : "Laplace");
 }
@@ -534,8 +543,9 @@ void FluidModel::read_checkpoint(const run::CheckpointReader& reader) {
 }
 
 void FluidModel::set_velocity_constraint(std::span<const int> vertices,
-                                         std::span<const double> velocities) {
-  fluid_->set_velocity_constraint(vertices, velocities);
+                                         std::span<const double> velocities,
+                                         std::span<const double> cell_coverage) {
+  fluid_->set_velocity_constraint(vertices, velocities, cell_coverage);
 }
 
 std::vector<double> FluidModel::constraint_reactions() {

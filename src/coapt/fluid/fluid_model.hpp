@@ -183,8 +183,10 @@ class FluidModel {
   void read_checkpoint(const run::CheckpointReader& reader);
 
   /// Constrains the velocity at owned local vertices (vertices.size() × dim velocities, row
-  /// major) [m/s] for the following solves (NavierStokes::set_velocity_constraint).
-  void set_velocity_constraint(std::span<const int> vertices, std::span<const double> velocities);
+  /// major) [m/s] for the following solves; `cell_coverage` per owned cell, the fraction the
+  /// solids cover (NavierStokes::set_velocity_constraint).
+  void set_velocity_constraint(std::span<const int> vertices, std::span<const double> velocities,
+                               std::span<const double> cell_coverage = {});
   /// The force the fluid exerts on the constraint at each constrained vertex (same layout)
   /// at the current state [N/m in 2D, N in 3D].
   std::vector<double> constraint_reactions();

@@ -284,10 +284,15 @@ void NavierStokes::set_dirichlet_dofs(std::vector<PetscInt> dofs) {
 }
 
 void NavierStokes::set_velocity_constraint(std::span<const int> vertices,
-                                           std::span<const double> velocities) {
+                                           std::span<const double> velocities,
+                                           std::span<const double> cell_coverage) {
   const int dim = mesh_.dim, n = dim + 1;
   if (velocities.size() != vertices.size() * static_cast<std::size_t>(dim))
     throw InternalError("set_velocity_constraint: velocities must be vertices × dim");
+  if (!cell_coverage.empty() &&
+      cell_coverage.size() != static_cast<std::size_t>(mesh_.n_owned_cells))
+    throw InternalError(
+        "set_velocity_constraint: cell_coverage must have one entry per owned cell");
   constrained_vertices_.assign(vertices.begin(), vertices.end());
   for (std::size_t k = 0; k < vertices.size(); ++k) {
     const int v = vertices[k];
@@ -301,6 +306,18 @@ void NavierStokes::set_velocity_constraint(std::span<const int> vertices,
   COAPT_PETSC_CHECK(VecAssemblyEnd(state_));
   fem::update_ghosts(state_);
   if (parameters_.covered_continuity_factor == 1.0) return;
+  cell_coverage_.clear();
+  if (!cell_coverage
+           .empty()) {  // the owned cells' fractions, and the ghost cells' from their owners
+    if (!cell_fraction_) cell_fraction_ = fem::create_cell_vector(mesh_);
+    PetscScalar* owned = nullptr;
+    COAPT_PETSC_CHECK(VecGetArray(cell_fraction_, &owned));
+    std::copy(cell_coverage.begin(), cell_coverage.end(), owned);
+    COAPT_PETSC_CHECK(VecRestoreArray(cell_fraction_, &owned));
+    fem::update_ghosts(cell_fraction_);
+    fem::LocalValues local(cell_fraction_);
+    cell_coverage_.assign(local.values().begin(), local.values().end());
+  }
   // Per vertex 2: constrained, 1: all its velocity dofs Dirichlet (a wall inside the solid's
   // region), 0: free; the ghost vertices' flags come from their owners.
   auto flags = fem::create_vertex_vector(mesh_, 1);
@@ -643,9 +660,12 @@ void NavierStokes::assemble(const TimeLevel& time, bool with_matrix) {
   };
   // The factor on local cell c's continuity rows: covered_continuity_factor if its vertices
   // all carry the velocity constraint or have Dirichlet velocities, at least one the
-  // constraint; else 1.
+  // constraint, and the solids cover covered_continuity_coverage of it; else 1.
   auto continuity_factor = [&](int c) {
     if (constrained_vertex_flag_.empty()) return 1.0;
+    if (!cell_coverage_.empty() &&
+        cell_coverage_[static_cast<std::size_t>(c)] < parameters_.covered_continuity_coverage)
+      return 1.0;
     const auto vertices = mesh_.cell(c);
     bool constrained = false;
     for (int a = 0; a < n; ++a) {

@@ -39,6 +39,10 @@ struct FluidParameters {
   /// carry the velocity constraint or Dirichlet velocities, one at least the constraint (inside
   /// an immersed solid). 1: no change.
   double covered_continuity_factor = 1.0;
+  /// ... and of which the solids cover at least this fraction (set_velocity_constraint's
+  /// cell_coverage): a cell only partly inside, such as one that spans the gap between two
+  /// leaflets, holds fluid whose mass balance the factor would spoil. 0: the vertex rule alone.
+  double covered_continuity_coverage = 1.0 - 1e-6;
   double newton_relative_tolerance = 1e-8;   ///< ‖R‖ ≤ rtol ‖R₀‖ ...
   double newton_absolute_tolerance = 1e-10;  ///< ... or ‖R‖ ≤ atol
   int newton_max_iterations = 25;
@@ -96,8 +100,11 @@ class NavierStokes {
   void set_dirichlet_dofs(std::vector<PetscInt> dofs);
   /// Constrains the velocity at owned local vertices `vertices` to `velocities`
   /// (vertices.size() × dim, row-major) [m/s]; replaces the previous constraint. The state is
-  /// updated at those dofs; the matrix pattern stays fixed.
-  void set_velocity_constraint(std::span<const int> vertices, std::span<const double> velocities);
+  /// updated at those dofs; the matrix pattern stays fixed. `cell_coverage`: per owned cell,
+  /// the fraction of it the solids cover (for covered_continuity_coverage; empty: not known,
+  /// the vertex rule alone decides).
+  void set_velocity_constraint(std::span<const int> vertices, std::span<const double> velocities,
+                               std::span<const double> cell_coverage = {});
 
   /// Draws the velocity at owned local vertices `vertices` towards `targets` (vertices.size()
   /// × dim, row-major) [m/s] by a penalty: R_(v,i) += κ_k (u_(v,i) − w_(k,i)) with
@@ -214,6 +221,11 @@ class NavierStokes {
   /// Per local vertex (owned and ghost): 2 carries the velocity constraint, 1 has Dirichlet
   /// velocities, 0 free (set only when covered_continuity_factor ≠ 1).
   std::vector<char> constrained_vertex_flag_;
+  /// Per local cell (owned and ghost: the matrix is assembled over both): the fraction the
+  /// solids cover (set only when covered_continuity_factor ≠ 1 and the caller gave it), and
+  /// the ghosted vector that brings the ghost cells' values from their owners.
+  std::vector<double> cell_coverage_;
+  OwnedVec cell_fraction_;
   /// The velocity penalty: owned local vertices, weights, targets (dim each), and per owned
   /// vertex ∫φ_v and ∫|∇φ_v|² (computed on the first penalty).
   std::vector<int> penalty_vertices_;

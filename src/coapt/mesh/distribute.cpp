@@ -77,8 +77,9 @@ VertexCells vertex_cells(const Mesh& whole) {
 
 /// This rank's part, built on rank 0 from the whole mesh and the partition.
 Mesh extract_part(const Mesh& whole, const std::vector<int>& cell_part,
-                  const std::vector<int>& vertex_owner, const std::vector<PetscInt>& new_number,
-                  const std::vector<PetscInt>& offsets, const VertexCells& adjacency, int part) {
+                  const std::vector<PetscInt>& cell_number, const std::vector<int>& vertex_owner,
+                  const std::vector<PetscInt>& new_number, const std::vector<PetscInt>& offsets,
+                  const VertexCells& adjacency, int part) {
   const int k = whole.vertices_per_cell(), dim = whole.dim;
   Mesh local;
   local.dim = dim;
@@ -140,6 +141,7 @@ Mesh extract_part(const Mesh& whole, const std::vector<int>& cell_part,
       local.cells.push_back(local_index[whole.cells[static_cast<std::size_t>(c) * k + a]]);
     local.cell_tags.push_back(whole.cell_tags[c]);
     local.original_cell.push_back(whole.original_cell[c]);
+    local.global_cell.push_back(cell_number[c]);
   }
   local.n_owned_cells = static_cast<int>(owned_cells.size());
 
@@ -165,6 +167,7 @@ void send_part(const Mesh& part, int to, MPI_Comm comm) {
   send_vector(part.cells, to, comm);
   send_vector(part.cell_tags, to, comm);
   send_vector(part.original_cell, to, comm);
+  send_vector(part.global_cell, to, comm);
   send_vector(part.facets, to, comm);
   send_vector(part.facet_tags, to, comm);
   send_vector(part.facet_cell, to, comm);
@@ -186,6 +189,7 @@ Mesh receive_part(MPI_Comm comm) {
   receive_vector(part.cells, 0, comm);
   receive_vector(part.cell_tags, 0, comm);
   receive_vector(part.original_cell, 0, comm);
+  receive_vector(part.global_cell, 0, comm);
   receive_vector(part.facets, 0, comm);
   receive_vector(part.facet_tags, 0, comm);
   receive_vector(part.facet_cell, 0, comm);
@@ -257,9 +261,16 @@ Mesh distribute(const Mesh& whole, MPI_Comm comm, Partitioner partitioner) {
           new_number(static_cast<std::size_t>(nv), -1);
       for (int v = 0; v < nv; ++v)
         if (vertex_owner[v] < size) new_number[v] = next[vertex_owner[v]]++;
+      // Cells are numbered rank by rank, in source order within a rank (extract_part's order).
+      std::vector<PetscInt> cell_next(static_cast<std::size_t>(size) + 1, 0),
+          cell_number(static_cast<std::size_t>(whole.n_cells()));
+      for (const int p : cell_part) ++cell_next[static_cast<std::size_t>(p) + 1];
+      std::partial_sum(cell_next.begin(), cell_next.end(), cell_next.begin());
+      for (int c = 0; c < whole.n_cells(); ++c) cell_number[c] = cell_next[cell_part[c]]++;
       const auto adjacency = vertex_cells(whole);
       for (int p = size - 1; p >= 0; --p) {
-        Mesh part = extract_part(whole, cell_part, vertex_owner, new_number, offsets, adjacency, p);
+        Mesh part = extract_part(whole, cell_part, cell_number, vertex_owner, new_number, offsets,
+                                 adjacency, p);
         if (p == 0)
           local = std::move(part);
         else {

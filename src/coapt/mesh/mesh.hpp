@@ -9,7 +9,7 @@
 ///    a PETSc vector with n_owned_vertices local entries (per component) matches them;
 ///  - cells: owned ones first [0, n_owned_cells) (each cell is owned by exactly one rank:
 ///    assemble over these), then a ghost layer (every cell sharing a vertex with an owned
-///    cell);
+///    cell); owned cells have the contiguous global numbers of global_cell;
 ///  - boundary facets: those of local cells, each with the local cell it bounds.
 
 #include <mpi.h>
@@ -51,6 +51,10 @@ struct Mesh {
   std::vector<std::int64_t> original_cell;  ///< element number in the source (Gmsh element tag)
   int n_owned_cells = 0;
   std::int64_t n_global_cells = 0;
+  /// Global number of each local cell (owned cells numbered rank by rank, in their local
+  /// order, so that a PETSc vector with n_owned_cells local entries matches them); empty on a
+  /// whole mesh, whose cells are numbered by their index.
+  std::vector<PetscInt> global_cell;
 
   // Boundary facets (segments in 2D, triangles in 3D)
   std::vector<int> facets;      ///< n_facets × dim local vertex indices (normal out of facet_cell)

@@ -35,6 +35,7 @@ struct LocalOperators {
   std::vector<double> dual_integral;  ///< per local slave vertex: ∫_Ω ψ_i (owned cells' part)
   std::vector<double> covered;        ///< ∫_Ω λ_i
   std::vector<double> full;           ///< ∫_S λ_i
+  std::vector<double> cell_coverage;  ///< per owned slave cell T: |T ∩ M| / |T|
   std::vector<int> mass_cells;        ///< owned slave cells with overlap (standard only)
   std::vector<double> mass_blocks;    ///< (d+1)² values of ∫_Ω λ_a λ_b per mass cell
   std::int64_t intersecting_pairs = 0;
@@ -86,6 +87,7 @@ class Engine final : public TransferEngine {
     out.dual_integral.assign(static_cast<std::size_t>(n_rows), 0.0);
     out.covered.assign(static_cast<std::size_t>(n_rows), 0.0);
     out.full.assign(static_cast<std::size_t>(n_rows), 0.0);
+    out.cell_coverage.assign(static_cast<std::size_t>(slave.n_owned_cells), 0.0);
     out.mass_cells.clear();
     out.mass_blocks.clear();
     workspace_.second_moment = overlap_mass;  // mass_matrix() needs it, B and D do not
@@ -140,6 +142,7 @@ class Engine final : public TransferEngine {
         if (primal) primal_row[a] = row[a]->primal.data();
       }
       NodalMatrix<dim> mass_block{};
+      double overlap = 0;  // |T ∩ M| = Σ_a ∫_Ω λ_a (the λ_a sum to 1)
       for (std::size_t q = 0; q < n_hits; ++q) {
         const LocalIntegrals<dim>& local = buffer_[q];
         const NodalMatrix<dim> dual = dual_mass(local);
@@ -154,6 +157,7 @@ class Engine final : public TransferEngine {
         for (int a = 0; a < k; ++a) {
           out.dual_integral[vertices[a]] += dual_integral[a];
           out.covered[vertices[a]] += local.integral_a[a];
+          overlap += local.integral_a[a];
         }
         if (overlap_mass) {
           const NodalMatrix<dim> m = mass_matrix(local.moments, s, s);
@@ -161,6 +165,7 @@ class Engine final : public TransferEngine {
             for (int b = 0; b < k; ++b) mass_block[a][b] += m[a][b];
         }
       }
+      out.cell_coverage[static_cast<std::size_t>(c)] = overlap / s.measure;
       if (overlap_mass) {
         out.mass_cells.push_back(c);
         for (int a = 0; a < k; ++a)
@@ -359,6 +364,7 @@ void VariationalTransfer::assemble() {
   // D, the coverage and the constrained set.
   dual_mass_ = sum_vertex_values(slave, local.dual_integral);
   covered_integral_ = sum_vertex_values(slave, local.covered);
+  cell_coverage_ = std::move(local.cell_coverage);
   const Vec covered = covered_integral_.get();
   OwnedVec full = sum_vertex_values(slave, local.full);
   if (!coverage_) coverage_ = layout_vector(slave.comm, slave);

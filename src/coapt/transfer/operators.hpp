@@ -15,6 +15,7 @@
 ///   D_i  = ∫_Ω ψ_i          Vec in the slave layout (the diagonal mortar matrix). Σ_j B_ij = D_i
 ///                           exactly, because Σ_j φ_j = 1 on M.
 ///   c_i  = ∫_Ω λ_i / ∫_S λ_i  covered fraction of node i's support (Vec, slave layout)
+///   |T ∩ M| / |T|           covered fraction of each owned slave cell T (local values)
 ///   T    = D⁻¹ B            the transfer master → slave, on the constrained rows only
 ///
 /// Covered-node rule. Biorthogonality holds on whole slave elements only: on an element cut
@@ -110,6 +111,9 @@ class VariationalTransfer {
   Vec coverage() const { return coverage_.get(); }
   /// ∫_Ω λ_i = Σ_j B^std_ij (slave layout).
   Vec covered_integral() const { return covered_integral_.get(); }
+  /// Per owned slave cell T (local index): |T ∩ M| / |T|, the fraction of the cell the master
+  /// covers.
+  const std::vector<double>& cell_coverage() const { return cell_coverage_; }
   /// Owned global slave rows of the constrained nodes (ascending).
   const std::vector<PetscInt>& constrained_rows() const { return constrained_rows_; }
   /// The same as an IS on the slave communicator.
@@ -155,6 +159,7 @@ class VariationalTransfer {
   std::size_t pattern_size_ = 0;
   OwnedMat coupling_, standard_coupling_, overlap_mass_;
   OwnedVec dual_mass_, coverage_, covered_integral_, work_slave_;
+  std::vector<double> cell_coverage_;  ///< per owned slave cell
   std::vector<PetscInt> constrained_rows_;
   std::vector<int> constrained_local_;  ///< owned local indices of constrained_rows_
   std::vector<double> inverse_dual_;    ///< 1 / D_i on constrained_local_

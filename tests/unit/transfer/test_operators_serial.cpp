@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <petscmat.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -166,6 +167,17 @@ void check_operators(const Mesh& slave, const Mesh& master, double overlap,
   PetscReal most = 0;
   VecMax(t.coverage(), nullptr, &most);
   EXPECT_LT(most, 1.0 + 1e-12);
+  {  // the cells' covered fractions: in [0, 1], and Σ_T |T| f_T = |Ω|
+    const auto& fraction = t.cell_coverage();
+    ASSERT_EQ(fraction.size(), static_cast<std::size_t>(slave.n_owned_cells));
+    double covered = 0;
+    for (int c = 0; c < slave.n_owned_cells; ++c) {
+      EXPECT_GE(fraction[c], 0.0);
+      EXPECT_LT(fraction[c], 1.0 + 1e-12);
+      covered += fraction[c] * std::fabs(mesh::cell_signed_measure(slave, c));
+    }
+    EXPECT_NEAR(covered, overlap, 1e-12 * overlap);
+  }
   if (std::getenv("COAPT_TRANSFER_REPORT"))  // the figures of docs/verification/transfer.md
     std::printf(
         "[transfer] %s: %d/%d slave/master cells, %lld pairs, |sum B - overlap|/overlap %.1e, "
@@ -369,6 +381,26 @@ TEST(TransferOperators, CoveredNodeRule) {
     }
   }
   VecRestoreArrayRead(t.coverage(), &c);
+  // the cells: whole left of x = 0.5, none right of 0.6, and half the column between
+  double column = 0;
+  for (int c = 0; c < slave.n_owned_cells; ++c) {
+    double lo = 1, hi = 0;
+    for (const int v : slave.cell(c)) {
+      lo = std::min(lo, slave.point(v)[0]);
+      hi = std::max(hi, slave.point(v)[0]);
+    }
+    const double f = t.cell_coverage()[c];
+    if (hi < 0.5 + 1e-12) {
+      EXPECT_NEAR(f, 1.0, 1e-14);
+    } else if (lo > 0.6 - 1e-12) {
+      EXPECT_EQ(f, 0.0);
+    } else {
+      EXPECT_GT(f, 0.0);
+      EXPECT_LT(f, 1.0);
+      column += f * std::fabs(mesh::cell_signed_measure(slave, c));
+    }
+  }
+  EXPECT_NEAR(column, 0.05, 1e-14);
   VariationalTransfer loose(slave, master, {.coverage_threshold = 0.5});
   EXPECT_EQ(loose.n_constrained(), 6 * 11);
 }
