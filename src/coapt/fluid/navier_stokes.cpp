@@ -320,7 +320,9 @@ void NavierStokes::set_velocity_constraint(std::span<const int> vertices,
   }
   // Per vertex 2: constrained, 1: all its velocity dofs Dirichlet (a wall inside the solid's
   // region), 0: free; the ghost vertices' flags come from their owners.
-  auto flags = fem::create_vertex_vector(mesh_, 1);
+  if (!vertex_flags_) vertex_flags_ = fem::create_vertex_vector(mesh_, 1);
+  Vec flags = vertex_flags_.get();
+  COAPT_PETSC_CHECK(VecSet(flags, 0.0));
   for (int v = 0; v < mesh_.n_owned_vertices; ++v) {
     bool fixed = true;
     for (int i = 0; i < dim && fixed; ++i)

@@ -221,6 +221,7 @@ class NavierStokes {
   /// Per local vertex (owned and ghost): 2 carries the velocity constraint, 1 has Dirichlet
   /// velocities, 0 free (set only when covered_continuity_factor ≠ 1).
   std::vector<char> constrained_vertex_flag_;
+  OwnedVec vertex_flags_;  ///< the ghosted vector that brings the flags of ghost vertices
   /// Per local cell (owned and ghost: the matrix is assembled over both): the fraction the
   /// solids cover (set only when covered_continuity_factor ≠ 1 and the caller gave it), and
   /// the ghosted vector that brings the ghost cells' values from their owners.
