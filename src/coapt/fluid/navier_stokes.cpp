@@ -307,8 +307,8 @@ void NavierStokes::set_velocity_constraint(std::span<const int> vertices,
   fem::update_ghosts(state_);
   if (parameters_.covered_continuity_factor == 1.0) return;
   cell_coverage_.clear();
-  if (!cell_coverage
-           .empty()) {  // the owned cells' fractions, and the ghost cells' from their owners
+  // The cells' covered fractions: the owned cells' given, the ghost cells' from their owners.
+  if (!cell_coverage.empty()) {
     if (!cell_fraction_) cell_fraction_ = fem::create_cell_vector(mesh_);
     PetscScalar* owned = nullptr;
     COAPT_PETSC_CHECK(VecGetArray(cell_fraction_, &owned));
