@@ -1427,7 +1427,10 @@ class FsciProblem final : public run::Problem {
       }
     }
     const auto merged = group_->merge(shares);
-    fluid_.set_velocity_constraint(merged.vertices, merged.velocities, group_->cell_coverage());
+    // the cells' covered fractions only matter where the covered cells' continuity is scaled
+    const bool scaled = fluid_.parameters().fluid.covered_continuity_factor != 1.0;
+    fluid_.set_velocity_constraint(merged.vertices, merged.velocities,
+                                   scaled ? group_->cell_coverage() : std::vector<double>());
     // partial coverage: each solid's penalty entries, one after the other
     std::vector<int> vertices;
     std::vector<double> weights, targets;
