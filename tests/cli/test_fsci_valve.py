@@ -23,6 +23,9 @@ scaled by fluid.covered_continuity_factor 0.01):
    (measured 2.7 %: the divergence of the projected solid velocity in the scaled cells);
  - 2 ranks agree with 1 rank to the coupling tolerance (opening, flow and swept flow to 1e-3
    relative, at the last step where both runs took the same steps; measured 1.1e-5);
+ - cases/valve2d/wedge_sweep.py, on the 2-rank run's fields written at every step: the inner
+   sides it finds sweep what swept_flow says (to 1e-9 relative, or it exits non-zero), and it
+   finds the benchmark's one closed phase with its leak_volume;
  - to t = 0.03 s (before contact) with covered_continuity_factor 1 on 2 ranks, the fluid's
    mass balance is exact: the flows out through inlet and outlet sum to zero to 1e-12 of the
    flow, so the two measures of the leak differ by the leaflets' rate of change of volume
@@ -40,7 +43,10 @@ scaled by fluid.covered_continuity_factor 0.01):
    is an upstream surface the solid does not have, and a downstream boundary the fluid does not
    have."""
 
-from cli_common import Runner, parse_arguments, run_with_series
+import re
+import subprocess
+
+from cli_common import Runner, parse_arguments, read_json, run_with_series
 
 REVERSED = ["--set", "fluid.outlets[0].waveform.times=[0,0.03,1]",
             "--set", "fluid.outlets[0].waveform.values=[0,-1.5,-1.5]"]
@@ -74,7 +80,9 @@ def main():
     r = Runner(parse_arguments())
     series = {}
     for ranks in (1, 2):
-        summary, rows = run(r, f"valve-np{ranks}", ranks, 0.046)
+        # the 2-rank run writes the leaflets' fields at every step, for the wedge's sweep below
+        vtk = ("--set", "output.vtk=true", "--set", "output.vtk_interval=1") if ranks == 2 else ()
+        summary, rows = run(r, f"valve-np{ranks}", ranks, 0.046, vtk)
         if summary is None:
             continue
         b = summary["benchmark"]
@@ -129,6 +137,20 @@ def main():
     if 1 in series and 2 in series:
         difference, time = agreement(series[1], series[2])
         r.expect(difference < 1e-3, f"2 ranks agree with 1 rank at t = {time} s ({difference:.1e} < 1e-3)")
+
+    # The wedge between the coaptation faces (cases/valve2d/wedge_sweep.py), from the 2-rank
+    # run's fields (written in two pieces): its inner sides sweep what swept_flow says, and its
+    # closed phase and leak are the benchmark's.
+    if 2 in series:
+        result = subprocess.run(["/usr/bin/python3", str(r.source / "cases" / "valve2d" / "wedge_sweep.py"),
+                                 str(r.work / "valve-np2")], capture_output=True, text=True, check=False)
+        print(result.stdout.strip())
+        phases = re.findall(r"closed (\S+)-(\S+) s: .* W = (\S+) m\^2; leak \(inlet side\) (\S+) ->", result.stdout)
+        leak = read_json(r.work / "valve-np2" / "summary.json")["benchmark"]["leak_volume"]
+        r.expect(result.returncode == 0 and len(phases) == 1 and len(leak) == 1
+                 and abs(float(phases[0][3]) - leak[0]) <= 1e-3 * abs(leak[0]) + 1e-15,
+                 "wedge_sweep.py: the inner sides' sweep is swept_flow, one closed phase, its leak "
+                 "the benchmark's", result.stdout + result.stderr)
 
     # The continuity equation scaled in the covered cells: the fluid's net outflow is the
     # divergence in the cells it is scaled in. With the default covered_continuity_coverage

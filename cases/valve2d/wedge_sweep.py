@@ -1,0 +1,145 @@
+#!/usr/bin/python3
+"""The part of the valve's leak that is the wedge between the coaptation faces (a diagnostic of
+docs/verification/fsci.md, "The case as committed since 2026-12-07"): from a valve2d run with
+the solid's fields written at every step (output.vtk_interval 1), per closed phase, the volume
+swept by the parts of the two coaptation faces downstream of where they touch.
+
+The swept flow S of the benchmark counts the whole inner sides (benchmark.upstream_surfaces:
+lower_inner, upper_inner) as the inlet's side's. Once the faces touch, the fluid between their
+parts downstream of the contact point (the wedge they open, and the upper face's overhang) is
+the outlet's, so S counts their sweep W on the wrong side, and both leak measures (leak_volume
+and leak_volume_downstream) are off by the same W: without it they are leak + W.
+
+Per step, from the deformed coordinates at the step's start and end, each inner facet sweeps
+the area (d0 + d1)/2 . n|F| (n out of the solid at the mid-path: exact for the straight path
+the benchmark takes); the sum over all inner facets is checked against swept_flow of
+series.csv. W sums the facets of the lower face (outward normal +y) whose reference nodes lie
+downstream of the most upstream active contact node at the step's end, and of the upper face
+(normal -y) whose deformed midpoint lies downstream of that node's deformed position. The
+contact point is taken at a node, so W is approximate to a facet.
+
+    /usr/bin/python3 cases/valve2d/wedge_sweep.py RUN_DIR
+"""
+
+import csv
+import sys
+import xml.etree.ElementTree as ElementTree
+from pathlib import Path
+
+import numpy as np
+from vtkmodules.util.numpy_support import vtk_to_numpy
+from vtkmodules.vtkIOXML import vtkXMLPUnstructuredGridReader
+
+FACE_NORMAL = 0.999  # |n_y| of a facet on a coaptation face (flat, along x)
+
+
+def read(path):
+    """Reference coordinates, displacement and contact_active of one .pvtu of the solid, one
+    vertex per global id in the ids' order (so that every step lists them alike), and its
+    triangles."""
+    reader = vtkXMLPUnstructuredGridReader()
+    reader.SetFileName(str(path))
+    reader.Update()
+    grid = reader.GetOutput()
+    data = grid.GetPointData()
+    ids = vtk_to_numpy(data.GetArray("global_id")).astype(np.int64)
+    # one copy of the vertices that several ranks write
+    _, keep, inverse = np.unique(ids, return_index=True, return_inverse=True)
+    cells = inverse[vtk_to_numpy(grid.GetCells().GetConnectivityArray()).reshape(-1, 3)]
+    return (vtk_to_numpy(grid.GetPoints().GetData())[keep, :2],
+            vtk_to_numpy(data.GetArray("displacement"))[keep, :2],
+            vtk_to_numpy(data.GetArray("contact_active"))[keep], cells)
+
+
+def boundary_facets(points, cells):
+    """Boundary edges (a, b) ordered so that (b - a) turned clockwise points out of the solid,
+    with their outward unit normals in the reference configuration."""
+    count = {}
+    for cell in cells:
+        for i in range(3):
+            a, b, c = cell[i], cell[(i + 1) % 3], cell[(i + 2) % 3]
+            key = (min(a, b), max(a, b))
+            count.setdefault(key, []).append((a, b, c))
+    facets, normals = [], []
+    for edges in count.values():
+        if len(edges) != 1:
+            continue
+        a, b, c = edges[0]
+        edge = points[b] - points[a]
+        normal = np.array([edge[1], -edge[0]])
+        if np.dot(normal, points[c] - points[a]) > 0:  # the third vertex must be behind
+            a, b, normal = b, a, -normal
+        facets.append((a, b))
+        normals.append(normal / np.linalg.norm(normal))
+    return np.array(facets), np.array(normals)
+
+
+def swept(facets, start, end):
+    """The area each facet sweeps from start to end (positive out of the solid)."""
+    d = end - start
+    mid = 0.5 * (start + end)
+    edge = mid[facets[:, 1]] - mid[facets[:, 0]]
+    area_normal = np.stack([edge[:, 1], -edge[:, 0]], axis=1)
+    return np.einsum("ij,ij->i", 0.5 * (d[facets[:, 0]] + d[facets[:, 1]]), area_normal)
+
+
+def main():
+    if len(sys.argv) != 2:
+        sys.exit(__doc__)
+    run = Path(sys.argv[1])
+    steps = [(float(d.get("timestep")), run / d.get("file"))
+             for d in ElementTree.parse(run / "solid.pvd").getroot().iter("DataSet")]
+    with open(run / "series.csv") as f:
+        rows = [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
+    if len(steps) != len(rows):
+        sys.exit(f"{run}: {len(steps)} solid fields for {len(rows)} steps: write them at every "
+                 f"step (--set output.vtk_interval=1)")
+    points, displacement, _, cells = read(steps[0][1])
+    facets, normals = boundary_facets(points, cells)
+    centre = 0.5 * (points[:, 1].min() + points[:, 1].max())
+    lower = points[facets[:, 0], 1] < centre
+    # the inner sides face the other leaflet: upwards on the lower one, downwards on the upper
+    inner = np.where(lower, normals[:, 1] > 1e-6, normals[:, 1] < -1e-6)
+    lower_face = lower & (normals[:, 1] > FACE_NORMAL)
+    upper_face = ~lower & (normals[:, 1] < -FACE_NORMAL)
+    previous = points.copy()  # the run starts at rest
+    phases, worst = [], 0.0
+    for k, ((time, path), row) in enumerate(zip(steps, rows)):
+        _, displacement, active, _ = read(path)
+        current = points + displacement
+        step = time - (rows[k - 1]["time"] if k else 0.0)
+        sweep = swept(facets, previous, current)
+        total = sweep[inner].sum()
+        worst = max(worst, abs(total - row["swept_flow"] * step) / max(abs(total), 1e-30))
+        contact = np.flatnonzero(active > 0.5)
+        if len(contact):
+            node = contact[np.argmin(points[contact, 0])]  # the most upstream active node
+            downstream = ((lower_face & (points[facets[:, 0], 0] >= points[node, 0] - 1e-12)
+                           & (points[facets[:, 1], 0] >= points[node, 0] - 1e-12))
+                          | (upper_face & (0.5 * (current[facets[:, 0], 0] + current[facets[:, 1], 0])
+                                           >= current[node, 0])))
+            if not phases or phases[-1]["end"] != rows[k - 1]["time"]:
+                phases.append({"start": time, "wedge": 0.0, "leak": 0.0, "downstream": 0.0,
+                               "at": []})
+            phase = phases[-1]
+            phase["end"] = time
+            phase["wedge"] += sweep[downstream].sum()
+            phase["leak"] += row["leak_flow"] * step
+            phase["downstream"] += row.get("leak_flow_downstream", float("nan")) * step
+            phase["at"].append(points[node, 0])
+        previous = current
+    print(f"{run}: {len(steps)} steps; the inner sides' sweep against series.csv's swept_flow: "
+          f"largest relative difference {worst:.1e}")
+    if not worst < 1e-9:
+        sys.exit(f"{run}: the inner sides found here are not benchmark.upstream_surfaces (their "
+                 f"sweep differs from swept_flow by {worst:.1e} relative)")
+    for phase in phases:
+        print(f"closed {phase['start']:.4f}-{phase['end']:.4f} s: contact at reference x = "
+              f"{1e3 * min(phase['at']):.3f}-{1e3 * max(phase['at']):.3f} mm; the faces' sweep "
+              f"downstream of it W = {phase['wedge']:+.3e} m^2; leak (inlet side) "
+              f"{phase['leak']:+.3e} -> {phase['leak'] + phase['wedge']:+.3e}, leak (outlet side) "
+              f"{phase['downstream']:+.3e} -> {phase['downstream'] + phase['wedge']:+.3e} m^2")
+
+
+if __name__ == "__main__":
+    main()
