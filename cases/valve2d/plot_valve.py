@@ -36,14 +36,20 @@ def read_solid(path):
     return x, y, connectivity
 
 
-def main():
-    if len(sys.argv) != 3:
-        sys.exit(__doc__)
-    run = Path(sys.argv[2])
+def read_run(run):
+    """The solid's fields of a run, [(time, .pvtu path)] from solid.pvd, and series.csv's rows
+    as floats."""
     steps = [(float(d.get("timestep")), run / d.get("file"))
              for d in ElementTree.parse(run / "solid.pvd").getroot().iter("DataSet")]
     with open(run / "series.csv") as f:
         rows = [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
+    return steps, rows
+
+
+def main():
+    if len(sys.argv) != 3:
+        sys.exit(__doc__)
+    steps, rows = read_run(Path(sys.argv[2]))
     figure, (shape, history) = plt.subplots(1, 2, figsize=(12, 4.5))
     if len(steps) > 8:  # at most 8 shapes, evenly spread, the last one included
         steps = [steps[round(k * (len(steps) - 1) / 7)] for k in range(8)]

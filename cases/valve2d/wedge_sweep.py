@@ -21,12 +21,11 @@ contact point is taken at a node, so W is approximate to a facet.
     /usr/bin/python3 cases/valve2d/wedge_sweep.py RUN_DIR
 """
 
-import csv
 import sys
-import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
 import numpy as np
+from plot_valve import read_run  # this folder's
 from vtkmodules.util.numpy_support import vtk_to_numpy
 from vtkmodules.vtkIOXML import vtkXMLPUnstructuredGridReader
 
@@ -87,10 +86,7 @@ def main():
     if len(sys.argv) != 2:
         sys.exit(__doc__)
     run = Path(sys.argv[1])
-    steps = [(float(d.get("timestep")), run / d.get("file"))
-             for d in ElementTree.parse(run / "solid.pvd").getroot().iter("DataSet")]
-    with open(run / "series.csv") as f:
-        rows = [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
+    steps, rows = read_run(run)
     if len(steps) != len(rows):
         sys.exit(f"{run}: {len(steps)} solid fields for {len(rows)} steps: write them at every "
                  f"step (--set output.vtk_interval=1)")
