@@ -27,9 +27,9 @@ last 4 steps' columns, the continuity of the cells the leaflets cover wholly sca
   no retries) stops with exit status 1 and keeps the last good state (step 2) as a checkpoint:
   restarted from the failed run's folder with the factor 1, steps 3..4 are the straight run's
   bit for bit;
-- a step of the leaflets that fails (without retries: the step to t = 0.034 s, whose coupling
-  stagnates as the faces approach) leaves a checkpoint that is, file for file and bit for bit,
-  the one the same run stopped after step 16 writes: the failed try's constrained nodes,
+- a step of the leaflets in contact that fails (restarted from the checkpoint at step 22, the
+  pressure jumping to -1000 times 20 Pa over step 23, no retries) leaves a checkpoint that is,
+  file for file and bit for bit, the one it started from: the failed try's constrained nodes,
   force, contact state and forgotten IQN-ILS columns are put back;
 - a checkpoint of a flow run and a checkpoint with other solids are refused with one error
   line naming the folder, exit 2.
@@ -99,33 +99,33 @@ def main():
                       f"restart on 1 rank: step 24 agrees to 1e-5 (largest relative difference "
                       f"{worst:.2e})")
 
-    # A step of the leaflets that fails keeps the last good state, all of it: without retries
-    # the step to t = 0.034 s (step 17), whose coupling stagnates as the faces approach, fails
-    # after its iterations. Its try moves the leaflets, the constrained fluid nodes, the force
-    # B^T lambda and the contact state, and the failure forgets the IQN-ILS columns; the
-    # checkpoint it leaves must be, file for file and bit for bit, the one the same run
-    # stopped after step 16 writes.
-    no_retries = ["--set", "coupling.iteration.retries=0", "--set", "output.checkpoint_interval=16"]
-    failed = run("fails", 0.036, *no_retries)
-    good = run("good", 0.032, *no_retries)
+    # A step of the leaflets that fails keeps the last good state, all of it: restarted from
+    # the checkpoint at step 22 (in contact) with the pressure jumping to -1000 (in units of
+    # the case's 20 Pa) over step 23 and no retries, the step fails (the fluid's Newton
+    # diverges inside the coupling). Its try moves the leaflets, the constrained fluid nodes,
+    # the force B^T lambda and the contact state, and the failure forgets the IQN-ILS columns;
+    # the checkpoint it leaves must be, file for file and bit for bit, the one it started from.
+    jump = ["--set", "fluid.outlets[0].waveform.times=[0,0.03,0.043,0.045,1]",
+            "--set", "fluid.outlets[0].waveform.values=[0,-1.5,-1.5,-1000,-1000]",
+            "--set", "coupling.iteration.retries=0"]
+    failed = run("fails", 0.047, *jump, "--restart", work / "first")
     summary = read_json(work / "fails" / "summary.json")
     runner.expect(failed.returncode == 1 and summary.get("status") == "failed"
-                  and summary.get("last_good_step") == 16,
-                  f"leaflets: step 17 fails without retries, exit 1, last good step 16 "
+                  and summary.get("last_good_step") == 22,
+                  f"leaflets: the step with the jump fails, exit 1, last good step 22 "
                   f"(measured {summary.get('last_good_step')})",
                   failed.stdout[-2000:] + failed.stderr[-2000:])
-    runner.expect(good.returncode == 0, "leaflets: the run stopped after step 16 succeeds",
-                  good.stderr[-2000:])
-    if failed.returncode == 1 and good.returncode == 0:
-        files = sorted(path.name for path in (work / "good" / "checkpoint").glob("*.bin"))
+    if failed.returncode == 1:
+        files = sorted(path.name for path in (work / "first" / "checkpoint").glob("*.bin"))
         differ = [name for name in files
-                  if (work / "good" / "checkpoint" / name).read_bytes()
+                  if (work / "first" / "checkpoint" / name).read_bytes()
                   != (work / "fails" / "checkpoint" / name).read_bytes()]
         states = [read_json(work / name / "checkpoint" / "state.json")["state"]
-                  for name in ("good", "fails")]
+                  for name in ("first", "fails")]
         differ += [key for key in states[0] if states[0][key] != states[1].get(key)]
-        print(f"checkpoint after the failed step: {len(files)} fields, IQN-ILS columns "
-              f"{states[1]['iqn_columns']}; differing from the last good step's: {differ or 'none'}")
+        print(f"checkpoint after the failed step: {len(files)} files, IQN-ILS columns "
+              f"{states[1]['iqn_columns']}, {active[21]} active contact node(s); differing from "
+              f"the last good step's: {differ or 'none'}")
         runner.expect(len(files) > 0 and not differ and sum(states[1]["iqn_columns"]) > 0,
                       "leaflets: the failed run's checkpoint is the last good step's bit for bit "
                       "(fluid, leaflets, constrained nodes, force, contact, IQN-ILS columns)")
