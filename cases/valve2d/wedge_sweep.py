@@ -53,14 +53,13 @@ def read(path):
 def boundary_facets(points, cells):
     """Boundary edges (a, b) ordered so that (b - a) turned clockwise points out of the solid,
     with their outward unit normals in the reference configuration."""
-    count = {}
+    cells_of_edge = {}  # (a, b, the cell's third vertex) per cell of each edge
     for cell in cells:
         for i in range(3):
             a, b, c = cell[i], cell[(i + 1) % 3], cell[(i + 2) % 3]
-            key = (min(a, b), max(a, b))
-            count.setdefault(key, []).append((a, b, c))
+            cells_of_edge.setdefault((min(a, b), max(a, b)), []).append((a, b, c))
     facets, normals = [], []
-    for edges in count.values():
+    for edges in cells_of_edge.values():
         if len(edges) != 1:
             continue
         a, b, c = edges[0]

@@ -10,7 +10,8 @@ scaled by fluid.covered_continuity_factor 0.01):
    leaflets close (the opening shrinks at every step until the faces meet) and the flow
    reverses (out through the inlet);
  - the coaptation faces meet (made 0.1 mm apart, they touch at t = 0.041 s): contact from
-   then to the last step, no penetration beyond 1e-12 m over the run (measured 2.6e-18 and 6.6e-18 m);
+   then to the last step, no penetration beyond 1e-12 m over the run (measured 2.6e-18 and
+   6.6e-18 m);
  - while the valve closes (from step 6 to the last step without contact) the flow the leaflets'
    upstream sides sweep out over a step is 95-105 % of the outflow through the inlet over that
    step (the mean of its values at the step's ends; measured 98.4-102.4 %): the rest is the
