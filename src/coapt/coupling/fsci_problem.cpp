@@ -18,6 +18,7 @@
 #include "coapt/coupling/constraint_group.hpp"
 #include "coapt/coupling/immersed_constraint.hpp"
 #include "coapt/coupling/quasi_newton.hpp"
+#include "coapt/coupling/valve_surface.hpp"
 #include "coapt/fem/assembly.hpp"
 #include "coapt/fem/p1.hpp"
 #include "coapt/fluid/fluid_model.hpp"
@@ -281,7 +282,8 @@ Parameters read(const config::Section& root) {
          "boundary groups of the solid that face flow_boundary's side of the closed valve: "
          "the rate at which they sweep that side (the volume they sweep over the step, over "
          "dt) is taken from the flow, so that the leak excludes the fluid the moving leaflets "
-         "push out; "
+         "push out; only their part from the solid's clamped base (dirichlet) to the contact "
+         "zone counts, the rest bounding the other side (series swept_flow_past_contact); "
          "empty: the leak is the whole flow"});
     b.downstream_boundary = benchmark.get<std::string>(
         "downstream_boundary", "",
@@ -542,6 +544,12 @@ class FsciProblem final : public run::Problem {
         throw InputError(fmt::format(
             "benchmark.upstream_surfaces: solid '{}' has no boundary group '{}' (it has: {})",
             b.valve_solid, group, names.empty() ? "none" : names));
+      }
+      if (!b.upstream_surfaces.empty()) {
+        const auto& model = *find_solid(b.valve_solid)->model;
+        upstream_ = std::make_unique<UpstreamSurface>(model.mesh(), b.upstream_surfaces,
+                                                      model.dirichlet_dofs(),
+                                                      "benchmark.upstream_surfaces", b.valve_solid);
       }
     }
     if (!b.probe.empty()) {
@@ -1508,17 +1516,27 @@ class FsciProblem final : public run::Problem {
 
   /// The rate at which benchmark.upstream_surfaces of the valve's solid swept the fluid on the
   /// flow boundary's side over the step just converged, before the solids' commit: the volume
-  /// they sweep from uₙ to uₙ₊₁ (n out of the solid) over Δt. Summed over a phase it is the
-  /// change of the volume they bound, whatever the leaflets' velocities do from step to step.
+  /// they sweep from uₙ to uₙ₊₁ (n out of the solid) over Δt, counting only their part between
+  /// the clamped base and the contact zone at the step's end (valve_surface.hpp; the rest, the
+  /// sweep past the contact zone, bounds the other side). Summed over a phase it is the change
+  /// of the volume they bound, whatever the leaflets' velocities do from step to step.
   /// Collective.
   void measure_swept_flow(double step) {
     swept_flow_ = 0;
+    swept_past_contact_ = 0;
     volume_rate_ = 0;
     const auto& b = parameters_.benchmark;
     if (b.type != "valve") return;
-    const auto& model = *find_solid(b.valve_solid)->model;  // deformable: it has contact
-    for (const auto& group : b.upstream_surfaces)
-      swept_flow_ += model.surface_swept_volume(group) / step;
+    const auto* solid = find_solid(b.valve_solid);  // deformable: it has contact
+    const auto& model = *solid->model;
+    if (upstream_) {
+      const auto counted = upstream_->counted_vertices(solid->contact->constraints().pairs());
+      for (const auto& group : b.upstream_surfaces) {
+        const double part = model.surface_swept_volume(group, counted) / step;
+        swept_flow_ += part;
+        swept_past_contact_ += model.surface_swept_volume(group) / step - part;
+      }
+    }
     const double volume = model.volume();
     volume_rate_ = (volume - valve_volume_) / step;
     valve_volume_ = volume;
@@ -1640,6 +1658,7 @@ class FsciProblem final : public run::Problem {
       if (name != parameters_.benchmark.valve_solid) continue;
       record_valve(time, opening, *solid);
       series.add("swept_flow", valve_.swept.back());
+      series.add("swept_flow_past_contact", swept_past_contact_);
       series.add("leak_flow", valve_.flow.back() - valve_.swept.back());
       if (downstream_tag_ >= 0)
         series.add("leak_flow_downstream", valve_.downstream_leak(valve_.times.size() - 1));
@@ -1860,7 +1879,10 @@ class FsciProblem final : public run::Problem {
   std::unique_ptr<ConstraintGroup> group_;  ///< the solids' constraints together (after start)
   long long n_constrained_ = 0;  ///< distinct constrained fluid vertices of the last solve
   double force_balance_ = 0;     ///< max over solids of the relative force balance error
-  double swept_flow_ = 0;    ///< the valve's swept flow over the last committed step (0: steady)
+  double swept_flow_ = 0;  ///< the valve's swept flow over the last committed step (0: steady)
+  /// the upstream surfaces' swept flow past the contact zone over that step (not in swept_flow_)
+  double swept_past_contact_ = 0;
+  std::unique_ptr<UpstreamSurface> upstream_;  ///< benchmark.upstream_surfaces (valve; or null)
   double volume_rate_ = 0;   ///< the valve solid's change of volume over that step, over Δt
   double valve_volume_ = 0;  ///< the valve solid's volume at the last commit
   bool deformable_ = false;  ///< some solid is deformable: coupling iterations

@@ -19,6 +19,7 @@
 
 #include "coapt/core/collective.hpp"
 #include "coapt/core/context.hpp"
+#include "coapt/core/error.hpp"
 #include "coapt/core/log.hpp"
 #include "coapt/core/timer.hpp"
 #include "coapt/fem/assembly.hpp"
@@ -616,8 +617,12 @@ class SolidModelImpl {
     return motions;
   }
 
-  double surface_swept_volume(const std::string& boundary) const {
+  double surface_swept_volume(const std::string& boundary,
+                              std::span<const char> counted_vertices) const {
     const int tag = facet_tag(boundary, "surface_swept_volume");
+    if (!counted_vertices.empty() && counted_vertices.size() != mesh_.global_vertex.size())
+      throw Error(fmt::format("surface_swept_volume: {} vertex flags for {} vertices",
+                              counted_vertices.size(), mesh_.global_vertex.size()));
     fem::update_ghosts(u_committed_.get());
     fem::update_ghosts(u_.get());
     fem::LocalValues start(u_committed_.get()), end(u_.get());
@@ -648,6 +653,9 @@ class SolidModelImpl {
     for (int f = 0; f < mesh_.n_facets(); ++f) {
       if (mesh_.facet_tags[f] != tag || mesh_.facet_cell[f] >= mesh_.n_owned_cells) continue;
       const int* v = mesh_.facets.data() + static_cast<std::size_t>(f) * d;
+      if (!counted_vertices.empty() &&
+          std::none_of(v, v + d, [&](int a) { return counted_vertices[a] != 0; }))
+        continue;
       // Along the path every point of the facet moves by the P1 interpolant of the vertices'
       // moves, constant in tau, and the facet stays flat, so ∫_F Δx·n da = (mean Δx)·|F|n(tau).
       // |F|n is linear in tau in 2D and quadratic in 3D: the midpoint rule, resp. Simpson's
@@ -1875,8 +1883,9 @@ std::array<double, 9> SolidModel::mean_cauchy_stress() const {
 std::vector<double> SolidModel::reaction_force(const std::string& boundary) const {
   return impl_->reaction_force(boundary);
 }
-double SolidModel::surface_swept_volume(const std::string& boundary) const {
-  return impl_->surface_swept_volume(boundary);
+double SolidModel::surface_swept_volume(const std::string& boundary,
+                                        std::span<const char> counted_vertices) const {
+  return impl_->surface_swept_volume(boundary, counted_vertices);
 }
 std::vector<double> SolidModel::current_coordinates() const {
   return impl_->current_coordinates();

@@ -37,6 +37,7 @@
 
 #include <array>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -229,8 +230,11 @@ class SolidModel {
   /// whole boundary it is the change of volume(). Divided by Δt it is the rate at which that
   /// surface sweeps the space outside the body over the step, in step with the displacement
   /// (the trial velocity's flux ∫ v·n da need not be: contact-stabilized Newmark corrects u
-  /// without v). InputError when the group does not exist. Collective.
-  double surface_swept_volume(const std::string& boundary) const;
+  /// without v). `counted_vertices` (per local vertex, owned and ghost; empty: all): only the
+  /// group's facets with a flagged vertex count. InputError when the group does not exist.
+  /// Collective.
+  double surface_swept_volume(const std::string& boundary,
+                              std::span<const char> counted_vertices = {}) const;
   /// The current coordinates X + u of the local vertices (owned and ghost), row-major.
   std::vector<double> current_coordinates() const;
 

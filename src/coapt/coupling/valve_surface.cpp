@@ -1,0 +1,141 @@
+#include "coapt/coupling/valve_surface.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <mpi.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "coapt/core/error.hpp"
+
+namespace coapt::coupling {
+
+std::vector<char> reached_nodes(const contact::Surface& surface, std::span<const char> seed,
+                                std::span<const char> blocked) {
+  const int n_nodes = surface.n_nodes();
+  // the facets of each node
+  std::vector<std::vector<int>> facets_of(static_cast<std::size_t>(n_nodes));
+  for (int f = 0; f < surface.n_facets(); ++f)
+    for (const int node : surface.facet(f)) facets_of[static_cast<std::size_t>(node)].push_back(f);
+  std::vector<char> reached(static_cast<std::size_t>(n_nodes), 0);
+  std::vector<int> front;
+  for (int node = 0; node < n_nodes; ++node)
+    if (seed[static_cast<std::size_t>(node)] && !blocked[static_cast<std::size_t>(node)]) {
+      reached[static_cast<std::size_t>(node)] = 1;
+      front.push_back(node);
+    }
+  while (!front.empty()) {
+    const int node = front.back();
+    front.pop_back();
+    for (const int f : facets_of[static_cast<std::size_t>(node)])
+      for (const int next : surface.facet(f)) {
+        const auto k = static_cast<std::size_t>(next);
+        if (reached[k] || blocked[k]) continue;
+        reached[k] = 1;
+        front.push_back(next);
+      }
+  }
+  return reached;
+}
+
+std::vector<PetscInt> contact_zone_vertices(const std::vector<contact::PairState>& pairs) {
+  std::vector<PetscInt> zone;
+  for (const auto& pair : pairs) {
+    if (pair.active.empty()) continue;
+    for (int j = 0; j < pair.slave.n_nodes(); ++j)
+      if (pair.active[static_cast<std::size_t>(j)])
+        zone.push_back(pair.slave.global_vertex[static_cast<std::size_t>(j)]);
+    const auto& master = pair.master;
+    if (pair.master_x.size() != static_cast<std::size_t>(master.n_nodes() * master.dim)) continue;
+    // ∫_Γm N_l = Σ over l's facets of |F| / (vertices per facet), at the current coordinates
+    std::vector<double> support(static_cast<std::size_t>(master.n_nodes()), 0.0);
+    for (int f = 0; f < master.n_facets(); ++f) {
+      const auto an = contact::facet_area_normal(master, pair.master_x, f);
+      const double measure = std::sqrt(an[0] * an[0] + an[1] * an[1] + an[2] * an[2]);
+      for (const int l : master.facet(f))
+        support[static_cast<std::size_t>(l)] += measure / master.dim;
+    }
+    std::vector<double> covered(support.size(), 0.0);
+    for (const auto& entry : pair.mortar.master_coupling)
+      if (pair.active[static_cast<std::size_t>(entry.row)])
+        covered[static_cast<std::size_t>(entry.column)] += entry.value;
+    for (std::size_t l = 0; l < support.size(); ++l)
+      if (support[l] > 0 && covered[l] >= 0.5 * support[l]) zone.push_back(master.global_vertex[l]);
+  }
+  std::sort(zone.begin(), zone.end());
+  zone.erase(std::unique(zone.begin(), zone.end()), zone.end());
+  return zone;
+}
+
+namespace {
+
+std::vector<int> boundary_tags(const mesh::Mesh& mesh, const std::vector<std::string>& groups,
+                               const std::string& key, const std::string& solid) {
+  std::vector<int> tags;
+  for (const auto& name : groups) {
+    const auto* group = mesh.find_group(name);
+    if (!group || group->dim != mesh.dim - 1)
+      throw InputError(fmt::format("{}: solid '{}' has no boundary group '{}'", key, solid, name));
+    tags.push_back(group->tag);
+  }
+  return tags;
+}
+
+}  // namespace
+
+UpstreamSurface::UpstreamSurface(const mesh::Mesh& mesh, const std::vector<std::string>& groups,
+                                 std::span<const PetscInt> dirichlet_dofs, const std::string& key,
+                                 const std::string& solid)
+    : mesh_(mesh),
+      surface_(contact::gather_surface(mesh, boundary_tags(mesh, groups, key, solid),
+                                       fmt::format("{}", fmt::join(groups, ", ")))) {
+  const int n_nodes = surface_.n_nodes();
+  for (int node = 0; node < n_nodes; ++node)
+    node_of_vertex_.emplace(surface_.global_vertex[static_cast<std::size_t>(node)], node);
+  // a node is clamped when one of its components is prescribed (on the rank owning it)
+  std::vector<int> clamped(static_cast<std::size_t>(n_nodes), 0);
+  const PetscInt first = mesh.vertex_offset, end = mesh.vertex_offset + mesh.n_owned_vertices;
+  for (int node = 0; node < n_nodes; ++node) {
+    const PetscInt vertex = surface_.global_vertex[static_cast<std::size_t>(node)];
+    if (vertex < first || vertex >= end) continue;
+    for (int i = 0; i < mesh.dim; ++i)
+      if (std::binary_search(dirichlet_dofs.begin(), dirichlet_dofs.end(), vertex * mesh.dim + i))
+        clamped[static_cast<std::size_t>(node)] = 1;
+  }
+  MPI_Allreduce(MPI_IN_PLACE, clamped.data(), n_nodes, MPI_INT, MPI_MAX, mesh.comm);
+  clamped_.assign(clamped.begin(), clamped.end());
+  const std::vector<char> none(static_cast<std::size_t>(n_nodes), 0);
+  const auto reached = reached_nodes(surface_, clamped_, none);
+  const auto loose = std::find(reached.begin(), reached.end(), 0);
+  if (loose != reached.end()) {
+    const auto node = static_cast<std::size_t>(loose - reached.begin());
+    const double* x = surface_.reference.data() + node * static_cast<std::size_t>(mesh.dim);
+    throw InputError(fmt::format(
+        "{}: a part of [{}] of solid '{}' is not joined to a clamped node (a `dirichlet` "
+        "boundary of the solid), e.g. the node at ({:g}, {:g}{}): the swept flow counts these "
+        "surfaces from the clamped base to the contact zone",
+        key, surface_.name, solid, x[0], x[1], mesh.dim == 3 ? fmt::format(", {:g}", x[2]) : ""));
+  }
+}
+
+std::vector<char> UpstreamSurface::counted_vertices(
+    const std::vector<contact::PairState>& pairs) const {
+  const auto n_nodes = static_cast<std::size_t>(surface_.n_nodes());
+  std::vector<char> blocked(n_nodes, 0);
+  for (const PetscInt vertex : contact_zone_vertices(pairs)) {
+    const auto found = node_of_vertex_.find(vertex);
+    if (found != node_of_vertex_.end()) blocked[static_cast<std::size_t>(found->second)] = 1;
+  }
+  const auto reached = reached_nodes(surface_, clamped_, blocked);
+  std::vector<char> counted(static_cast<std::size_t>(mesh_.n_vertices()), 0);
+  for (int v = 0; v < mesh_.n_vertices(); ++v) {
+    const auto found = node_of_vertex_.find(mesh_.global_vertex[static_cast<std::size_t>(v)]);
+    if (found != node_of_vertex_.end())
+      counted[static_cast<std::size_t>(v)] = reached[static_cast<std::size_t>(found->second)];
+  }
+  return counted;
+}
+
+}  // namespace coapt::coupling
