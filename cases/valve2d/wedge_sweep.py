@@ -15,7 +15,8 @@ that part by another rule and sets its W against the solver's.
 Per step, from the deformed coordinates at the step's start and end, each inner facet sweeps
 the area (d0 + d1)/2 . n|F| (n out of the solid at the mid-path: exact for the straight path
 the benchmark takes); the sum over all inner facets is checked against swept_flow +
-swept_flow_past_contact of series.csv. W sums the facets of the lower face (outward normal +y)
+swept_flow_past_contact + swept_flow_outside_fluid of series.csv (the last: the sweep of the
+inner sides' parts in the walls, where there is no fluid, not counted in S either). W sums the facets of the lower face (outward normal +y)
 whose reference nodes lie downstream of the most upstream active contact node at the step's
 end, and of the upper face (normal -y) whose deformed midpoint lies downstream of that node's
 deformed position. The solver cuts the upper face where the active nodes' multipliers cover
@@ -35,10 +36,10 @@ from vtkmodules.vtkIOXML import vtkXMLPUnstructuredGridReader
 FACE_NORMAL = 0.999  # |n_y| of a facet on a coaptation face (flat, along x)
 
 
-def read(path):
+def read(path, extra=()):
     """Reference coordinates, displacement and contact_active of one .pvtu of the solid, one
     vertex per global id in the ids' order (so that every step lists them alike), and its
-    triangles."""
+    triangles; then the (x, y) of each vector field named in `extra`."""
     reader = vtkXMLPUnstructuredGridReader()
     reader.SetFileName(str(path))
     reader.Update()
@@ -50,7 +51,8 @@ def read(path):
     cells = inverse[vtk_to_numpy(grid.GetCells().GetConnectivityArray()).reshape(-1, 3)]
     return (vtk_to_numpy(grid.GetPoints().GetData())[keep, :2],
             vtk_to_numpy(data.GetArray("displacement"))[keep, :2],
-            vtk_to_numpy(data.GetArray("contact_active"))[keep], cells)
+            vtk_to_numpy(data.GetArray("contact_active"))[keep], cells,
+            *(vtk_to_numpy(data.GetArray(name))[keep, :2] for name in extra))
 
 
 def boundary_facets(points, cells):
@@ -128,7 +130,8 @@ def main():
         step = time - (rows[k - 1]["time"] if k else 0.0)
         sweep = swept(facets, previous, current)
         total = sweep[inner].sum()
-        whole = row["swept_flow"] + row.get("swept_flow_past_contact", 0.0)
+        whole = (row["swept_flow"] + row.get("swept_flow_past_contact", 0.0)
+                 + row.get("swept_flow_outside_fluid", 0.0))
         worst = max(worst, abs(total - whole * step) / max(abs(total), 1e-30))
         downstream, node = past_contact(points, current, active, facets, lower_face, upper_face)
         if node is not None:
@@ -144,7 +147,8 @@ def main():
             phase["at"].append(points[node, 0])
         previous = current
     print(f"{run}: {len(steps)} steps; the inner sides' sweep against series.csv's swept_flow + "
-          f"swept_flow_past_contact: largest relative difference {worst:.1e}")
+          f"swept_flow_past_contact + swept_flow_outside_fluid: largest relative difference "
+          f"{worst:.1e}")
     if not worst < 1e-9:
         sys.exit(f"{run}: the inner sides found here are not benchmark.upstream_surfaces (their "
                  f"sweep differs from the series' by {worst:.1e} relative)")

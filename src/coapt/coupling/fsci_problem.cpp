@@ -283,7 +283,9 @@ Parameters read(const config::Section& root) {
          "the rate at which they sweep that side (the volume they sweep over the step, over "
          "dt) is taken from the flow, so that the leak excludes the fluid the moving leaflets "
          "push out; only their part from the solid's clamped base (dirichlet) to the contact "
-         "zone counts, the rest bounding the other side (series swept_flow_past_contact); "
+         "zone counts, the rest bounding the other side (series swept_flow_past_contact), and "
+         "of that only the facets with a node in the fluid mesh (series "
+         "swept_flow_outside_fluid: the rest); "
          "empty: the leak is the whole flow"});
     b.downstream_boundary = benchmark.get<std::string>(
         "downstream_boundary", "",
@@ -548,7 +550,7 @@ class FsciProblem final : public run::Problem {
       if (!b.upstream_surfaces.empty()) {
         const auto& model = *find_solid(b.valve_solid)->model;
         upstream_ = std::make_unique<UpstreamSurface>(model.mesh(), b.upstream_surfaces,
-                                                      model.dirichlet_dofs(),
+                                                      model.dirichlet_dofs(), fluid_.mesh(),
                                                       "benchmark.upstream_surfaces", b.valve_solid);
       }
     }
@@ -1517,24 +1519,30 @@ class FsciProblem final : public run::Problem {
   /// The rate at which benchmark.upstream_surfaces of the valve's solid swept the fluid on the
   /// flow boundary's side over the step just converged, before the solids' commit: the volume
   /// they sweep from uₙ to uₙ₊₁ (n out of the solid) over Δt, counting only their part between
-  /// the clamped base and the contact zone at the step's end (valve_surface.hpp; the rest, the
-  /// sweep past the contact zone, bounds the other side). Summed over a phase it is the change
-  /// of the volume they bound, whatever the leaflets' velocities do from step to step.
+  /// the clamped base and the contact zone at the step's end, in the fluid mesh
+  /// (valve_surface.hpp; the part past the contact zone bounds the other side, the part in a
+  /// wall no fluid). Summed over a phase it is the change of the volume they bound, whatever
+  /// the leaflets' velocities do from step to step.
   /// Collective.
   void measure_swept_flow(double step) {
     swept_flow_ = 0;
     swept_past_contact_ = 0;
+    swept_outside_fluid_ = 0;
     volume_rate_ = 0;
     const auto& b = parameters_.benchmark;
     if (b.type != "valve") return;
     const auto* solid = find_solid(b.valve_solid);  // deformable: it has contact
     const auto& model = *solid->model;
     if (upstream_) {
-      const auto counted = upstream_->counted_vertices(solid->contact->constraints().pairs());
+      const auto& pairs = solid->contact->constraints().pairs();
+      const auto counted = upstream_->counted_vertices(pairs);
+      const auto reached = upstream_->counted_vertices(pairs, false);
       for (const auto& group : b.upstream_surfaces) {
-        const double part = model.surface_swept_volume(group, counted) / step;
-        swept_flow_ += part;
-        swept_past_contact_ += model.surface_swept_volume(group) / step - part;
+        const double in_fluid = model.surface_swept_volume(group, counted) / step;
+        const double upstream = model.surface_swept_volume(group, reached) / step;
+        swept_flow_ += in_fluid;
+        swept_outside_fluid_ += upstream - in_fluid;
+        swept_past_contact_ += model.surface_swept_volume(group) / step - upstream;
       }
     }
     const double volume = model.volume();
@@ -1550,8 +1558,8 @@ class FsciProblem final : public run::Problem {
   }
 
   /// Closed phases (runs of steps with contact), in each the volume through flow_boundary
-  /// (Σ Q Δt over its steps) and the leak (Σ (Q − swept) Δt), the extremes of the opening and
-  /// the largest penetration.
+  /// (Σ Q̄ Δt over its steps, Q̄ the step's mean flow: ValveHistory::step_mean) and the leak
+  /// (Σ (Q̄ − swept) Δt), the extremes of the opening and the largest penetration.
   void valve_benchmark(io::Json& json) const {
     std::vector<double> leak, leak_downstream, outflow, phase_start, phase_end;
     double largest = 0, smallest = std::numeric_limits<double>::infinity();
@@ -1569,9 +1577,9 @@ class FsciProblem final : public run::Problem {
         phase_start.push_back(valve_.times[k]);
         phase_end.push_back(valve_.times[k]);
       }
-      leak.back() += (valve_.flow[k] - valve_.swept[k]) * dt;
+      leak.back() += valve_.leak(k) * dt;
       leak_downstream.back() += valve_.downstream_leak(k) * dt;
-      outflow.back() += valve_.flow[k] * dt;
+      outflow.back() += ValveHistory::step_mean(valve_.flow, k) * dt;
       phase_end.back() = valve_.times[k];
     }
     json["closed_phases"] = static_cast<std::int64_t>(leak.size());
@@ -1659,7 +1667,8 @@ class FsciProblem final : public run::Problem {
       record_valve(time, opening, *solid);
       series.add("swept_flow", valve_.swept.back());
       series.add("swept_flow_past_contact", swept_past_contact_);
-      series.add("leak_flow", valve_.flow.back() - valve_.swept.back());
+      series.add("swept_flow_outside_fluid", swept_outside_fluid_);
+      series.add("leak_flow", valve_.leak(valve_.times.size() - 1));
       if (downstream_tag_ >= 0)
         series.add("leak_flow_downstream", valve_.downstream_leak(valve_.times.size() - 1));
     }
@@ -1882,6 +1891,8 @@ class FsciProblem final : public run::Problem {
   double swept_flow_ = 0;  ///< the valve's swept flow over the last committed step (0: steady)
   /// the upstream surfaces' swept flow past the contact zone over that step (not in swept_flow_)
   double swept_past_contact_ = 0;
+  /// the sweep over that step of their part upstream of the contact zone outside the fluid mesh
+  double swept_outside_fluid_ = 0;
   std::unique_ptr<UpstreamSurface> upstream_;  ///< benchmark.upstream_surfaces (valve; or null)
   double volume_rate_ = 0;   ///< the valve solid's change of volume over that step, over Δt
   double valve_volume_ = 0;  ///< the valve solid's volume at the last commit
@@ -1898,11 +1909,25 @@ class FsciProblem final : public run::Problem {
     /// the flow out through the downstream boundary (0 without it) and the solid's rate of
     /// change of volume: the leak measured downstream is volume_rate − swept − downstream_flow
     std::vector<double> downstream_flow, volume_rate;
-    /// The leak across the valve towards flow_boundary at record k, measured on the other
-    /// side: the fluid there loses the volume the solid's boundary less its upstream surfaces
-    /// sweeps into it, and what flows out through the downstream boundary.
+    /// The mean over the step to record k of a flow sampled at the records' ends of steps,
+    /// by the trapezoidal rule (record 0: its own value). The swept volume and the change of
+    /// volume are the solid's displacement over the step, which Newmark's scheme (β = 1/4,
+    /// γ = 1/2) makes the trapezoidal rule of its velocity, Δu = Δt (vₙ + vₙ₊₁)/2, and the
+    /// fluid follows that velocity: a flow set against them must be integrated by the same
+    /// rule. Its value at the step's end alone (the rectangle rule) is off by Δt/2 times its
+    /// change over the step, which summed over a closed phase is Δt/2 times the change of the
+    /// flow from the phase's start to its end (docs/verification/fsci.md).
+    static double step_mean(const std::vector<double>& values, std::size_t k) {
+      return k > 0 ? 0.5 * (values[k - 1] + values[k]) : values[k];
+    }
+    /// The leak across the valve towards flow_boundary over the step to record k, as a rate:
+    /// the step's mean flow out through flow_boundary less the swept flow.
+    double leak(std::size_t k) const { return step_mean(flow, k) - swept[k]; }
+    /// The same leak measured on the other side: the fluid there loses the volume the
+    /// solid's boundary less its upstream surfaces sweeps into it, and what flows out through
+    /// the downstream boundary (the step's mean).
     double downstream_leak(std::size_t k) const {
-      return volume_rate[k] - swept[k] - downstream_flow[k];
+      return volume_rate[k] - swept[k] - step_mean(downstream_flow, k);
     }
     std::vector<char> closed;
     double max_penetration = 0;

@@ -9,8 +9,55 @@
 #include <cmath>
 
 #include "coapt/core/error.hpp"
+#include "coapt/transfer/geometry.hpp"
 
 namespace coapt::coupling {
+
+namespace {
+
+template <int dim>
+void mark_points_in_mesh(const mesh::Mesh& mesh, std::span<const double> points,
+                         std::vector<int>& inside) {
+  constexpr double tolerance = 1e-9;  // barycentric: relative to the cell's size
+  const auto n_points = static_cast<int>(inside.size());
+  // the points sorted by x, so that each cell visits only those within its x range
+  std::vector<int> order(static_cast<std::size_t>(n_points));
+  for (int p = 0; p < n_points; ++p) order[static_cast<std::size_t>(p)] = p;
+  const auto x = [&](int p) { return points[static_cast<std::size_t>(p) * dim]; };
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return x(a) < x(b); });
+  for (int c = 0; c < mesh.n_owned_cells; ++c) {
+    std::array<transfer::Point<dim>, dim + 1> vertices;
+    const auto cell = mesh.cell(c);
+    for (int a = 0; a <= dim; ++a)
+      for (int i = 0; i < dim; ++i) vertices[a][i] = mesh.point(cell[a])[i];
+    const auto simplex = transfer::make_simplex<dim>(vertices);
+    if (simplex.degenerate()) continue;
+    const double margin = tolerance * (simplex.box_upper[0] - simplex.box_lower[0]) + 1e-300;
+    auto p = std::lower_bound(order.begin(), order.end(), simplex.box_lower[0] - margin,
+                              [&](int q, double value) { return x(q) < value; });
+    for (; p != order.end() && x(*p) <= simplex.box_upper[0] + margin; ++p) {
+      if (inside[static_cast<std::size_t>(*p)]) continue;
+      transfer::Point<dim> point;
+      for (int i = 0; i < dim; ++i) point[i] = points[static_cast<std::size_t>(*p) * dim + i];
+      bool in = true;
+      for (int a = 0; a <= dim && in; ++a) in = simplex.barycentric(a, point) >= -tolerance;
+      if (in) inside[static_cast<std::size_t>(*p)] = 1;
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<char> points_in_mesh(const mesh::Mesh& mesh, std::span<const double> points) {
+  std::vector<int> inside(points.size() / static_cast<std::size_t>(mesh.dim), 0);
+  if (mesh.dim == 2)
+    mark_points_in_mesh<2>(mesh, points, inside);
+  else
+    mark_points_in_mesh<3>(mesh, points, inside);
+  MPI_Allreduce(MPI_IN_PLACE, inside.data(), static_cast<int>(inside.size()), MPI_INT, MPI_MAX,
+                mesh.comm);
+  return {inside.begin(), inside.end()};
+}
 
 std::vector<char> reached_nodes(const contact::Surface& surface, std::span<const char> seed,
                                 std::span<const char> blocked) {
@@ -86,7 +133,8 @@ std::vector<int> boundary_tags(const mesh::Mesh& mesh, const std::vector<std::st
 }  // namespace
 
 UpstreamSurface::UpstreamSurface(const mesh::Mesh& mesh, const std::vector<std::string>& groups,
-                                 std::span<const PetscInt> dirichlet_dofs, const std::string& key,
+                                 std::span<const PetscInt> dirichlet_dofs,
+                                 const mesh::Mesh& fluid_mesh, const std::string& key,
                                  const std::string& solid)
     : mesh_(mesh),
       surface_(contact::gather_surface(mesh, boundary_tags(mesh, groups, key, solid),
@@ -106,6 +154,7 @@ UpstreamSurface::UpstreamSurface(const mesh::Mesh& mesh, const std::vector<std::
   }
   MPI_Allreduce(MPI_IN_PLACE, clamped.data(), n_nodes, MPI_INT, MPI_MAX, mesh.comm);
   clamped_.assign(clamped.begin(), clamped.end());
+  in_fluid_ = points_in_mesh(fluid_mesh, surface_.reference);
   const std::vector<char> none(static_cast<std::size_t>(n_nodes), 0);
   const auto reached = reached_nodes(surface_, clamped_, none);
   const auto loose = std::find(reached.begin(), reached.end(), 0);
@@ -120,8 +169,8 @@ UpstreamSurface::UpstreamSurface(const mesh::Mesh& mesh, const std::vector<std::
   }
 }
 
-std::vector<char> UpstreamSurface::counted_vertices(
-    const std::vector<contact::PairState>& pairs) const {
+std::vector<char> UpstreamSurface::counted_vertices(const std::vector<contact::PairState>& pairs,
+                                                    bool fluid_only) const {
   const auto n_nodes = static_cast<std::size_t>(surface_.n_nodes());
   std::vector<char> blocked(n_nodes, 0);
   for (const PetscInt vertex : contact_zone_vertices(pairs)) {
@@ -132,8 +181,9 @@ std::vector<char> UpstreamSurface::counted_vertices(
   std::vector<char> counted(static_cast<std::size_t>(mesh_.n_vertices()), 0);
   for (int v = 0; v < mesh_.n_vertices(); ++v) {
     const auto found = node_of_vertex_.find(mesh_.global_vertex[static_cast<std::size_t>(v)]);
-    if (found != node_of_vertex_.end())
-      counted[static_cast<std::size_t>(v)] = reached[static_cast<std::size_t>(found->second)];
+    if (found == node_of_vertex_.end()) continue;
+    const auto node = static_cast<std::size_t>(found->second);
+    counted[static_cast<std::size_t>(v)] = reached[node] && (in_fluid_[node] || !fluid_only);
   }
   return counted;
 }

@@ -16,7 +16,9 @@
 ///    the master's counterpart of the slave's active set (Σ_j Φ̃_j = 1 on the contact zone,
 ///    so the sum is the part of N_l's support facing active slave nodes);
 ///  - reached nodes R: the unblocked nodes joined to an unblocked clamped node by a chain of
-///    facets through unblocked nodes; a facet counts when one of its nodes is in R.
+///    facets through unblocked nodes; a facet counts when one of its nodes is in R and lies in
+///    the fluid mesh (in the reference configuration): a leaflet clamped in a wall of the fluid
+///    mesh has a part of its surface outside the fluid, which sweeps no fluid.
 /// A chain of blocked nodes joined by facet edges cuts the surface (in 2D one node does), so
 /// the counted part ends at the contact zone's upstream edge, to a facet. Without contact
 /// every facet counts (every part of the surface must be joined to a clamped node: checked at
@@ -35,6 +37,11 @@
 
 namespace coapt::coupling {
 
+/// Per point (n × dim coordinates [m], the same on every rank): 1 when it lies in a cell of
+/// `mesh` on some rank, on its boundary included (to 1e-9 in barycentric coordinates).
+/// Collective on mesh.comm.
+std::vector<char> points_in_mesh(const mesh::Mesh& mesh, std::span<const double> points);
+
 /// Nodes of `surface` reached from the nodes with seed[node] != 0 along its facets without
 /// passing a node with blocked[node] != 0 (a blocked seed starts nothing): 1 per reached node.
 /// Serial.
@@ -51,22 +58,26 @@ class UpstreamSurface {
  public:
   /// The boundary facets of `mesh` in the boundary groups `groups` (gathered on every rank);
   /// the clamped nodes are those with a prescribed displacement component among
-  /// `dirichlet_dofs` (this rank's owned global dofs, interleaved: vertex · dim + component).
+  /// `dirichlet_dofs` (this rank's owned global dofs, interleaved: vertex · dim + component);
+  /// the nodes outside `fluid_mesh` (points_in_mesh, reference coordinates) count no facet.
   /// InputError naming `key`, the groups and `solid` when a group is not a boundary group of
   /// the mesh or a part of the surface is not joined to a clamped node. Collective.
   UpstreamSurface(const mesh::Mesh& mesh, const std::vector<std::string>& groups,
-                  std::span<const PetscInt> dirichlet_dofs, const std::string& key,
-                  const std::string& solid);
+                  std::span<const PetscInt> dirichlet_dofs, const mesh::Mesh& fluid_mesh,
+                  const std::string& key, const std::string& solid);
 
   /// Per local vertex of the mesh (owned and ghost): 1 on the nodes in R for the contact zone
-  /// of `pairs` (every surface node without contact), 0 elsewhere. A facet of the upstream
-  /// surfaces is counted when one of its vertices is flagged. Not collective.
-  std::vector<char> counted_vertices(const std::vector<contact::PairState>& pairs) const;
+  /// of `pairs` (every surface node without contact) that lie in the fluid mesh (all of them
+  /// with `fluid_only` false), 0 elsewhere. A
+  /// facet of the upstream surfaces is counted when one of its vertices is flagged. Not collective.
+  std::vector<char> counted_vertices(const std::vector<contact::PairState>& pairs,
+                                     bool fluid_only = true) const;
 
  private:
   const mesh::Mesh& mesh_;
   contact::Surface surface_;
   std::vector<char> clamped_;                         ///< per surface node
+  std::vector<char> in_fluid_;                        ///< per surface node
   std::unordered_map<PetscInt, int> node_of_vertex_;  ///< global vertex → surface node
 };
 

@@ -9,6 +9,7 @@
 #include "coapt/contact/mortar.hpp"
 #include "coapt/contact/surface.hpp"
 #include "coapt/coupling/valve_surface.hpp"
+#include "coapt/mesh/generators.hpp"
 
 namespace coapt::coupling {
 namespace {
@@ -94,6 +95,18 @@ TEST(ValveSurface, ContactZoneIsTheActiveSlaveNodesAndTheMasterNodesTheyCover) {
   pair.active[5] = pair.active[6] = pair.active[7] = 1;
   // master node k sits at x = 0.3 + 0.1 k: 0.5, 0.6, 0.7 are nodes 2, 3, 4 (global 102-104)
   EXPECT_EQ(contact_zone_vertices({pair}), (std::vector<PetscInt>{5, 6, 7, 102, 103, 104}));
+}
+
+TEST(ValveSurface, PointsInMeshIncludeItsBoundary) {
+  // the unit square, 4 x 4 squares; points inside, on an edge, at a corner and outside
+  const auto square = mesh::structured_rectangle(0.0, 0.0, 1.0, 1.0, 4, 4);
+  const std::vector<double> points{0.5,  0.5, 1.0, 0.3, 0.0,   0.0,    0.3,
+                                   0.25, 1.2, 0.5, 0.5, -1e-3, -1e-12, 0.5};
+  EXPECT_EQ(points_in_mesh(square, points), (std::vector<char>{1, 1, 1, 1, 0, 0, 1}));
+  // a box, in 3D
+  const auto box = mesh::structured_box(0.0, 0.0, 0.0, 1.0, 2.0, 1.0, 2, 2, 2);
+  const std::vector<double> points3{0.5, 1.5, 0.5, 1.0, 2.0, 1.0, 0.5, 2.1, 0.5};
+  EXPECT_EQ(points_in_mesh(box, points3), (std::vector<char>{1, 1, 0}));
 }
 
 }  // namespace

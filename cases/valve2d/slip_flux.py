@@ -1,0 +1,144 @@
+#!/usr/bin/python3
+"""Where the closed valve's leak goes (a diagnostic of docs/verification/fsci.md, "The case as
+committed since 2026-12-07"): from a valve2d run with the fluid's and the solid's fields
+written at every step (output.vtk_interval 1), per closed phase, the leak on the inlet's side
+split into the fluid's slip through the leaflets' upstream sides and the rest.
+
+The fluid on the inlet's side of the closed valve is bounded by the inlet, the walls, the
+leaflets' upstream sides Γ up to the contact point, and the contact point itself. The leak is
+Q − S (Q the flow out through the inlet, S the rate at which Γ sweeps that side). With F the
+flux of the fluid's velocity through Γ, F = ∫_Γ v_f · n (n out of the solid),
+
+    Q − S = (F − S) + (Q − F):
+
+ - F − S, the **slip**: the fluid's velocity on Γ is not the leaflets' (the immersed constraint
+   holds at the fluid nodes the solid covers; across the cells Γ cuts, the P1 velocity mixes
+   constrained and free nodes), so fluid crosses Γ. It is a discretisation error of the
+   immersed boundary's position;
+ - Q − F: what leaves the region otherwise, across the contact point and by the discrete
+   divergence of the fluid's velocity in the region (PSPG).
+
+The slip splits again, F − S = (F − V) + (V − S), with V the flux of the solid's own
+velocity through Γ: F − V is the fluid's velocity on Γ against the solid's, V − S the solid's
+velocity against its displacement (the contact-stabilized Newmark scheme moves the nodes in
+contact by a projected predictor, which the velocity does not follow).
+
+Γ is the inner sides of wedge_sweep.py without their part downstream of the contact node (its
+rule), less the facets that lie, in part, outside the fluid mesh (the leaflets' ends in the
+walls: no fluid there; their sweep is reported apart). F and V are evaluated at the steps'
+ends (the velocities interpolated at two Gauss points of each facet of Γ in its place at the
+step's end) and, like Q (the series' flow), integrated over each step by the trapezoidal rule,
+as the benchmark integrates Q (the flux at the step's start taken over the same facets in
+their place then); S is the sweep over the step of those facets (wedge_sweep.swept).
+
+    /usr/bin/python3 cases/valve2d/slip_flux.py RUN_DIR
+"""
+
+import sys
+import xml.etree.ElementTree as ElementTree
+from pathlib import Path
+
+import numpy as np
+from plot_valve import read_run  # this folder's
+from vtkmodules.util.numpy_support import vtk_to_numpy
+from vtkmodules.vtkCommonCore import vtkPoints
+from vtkmodules.vtkCommonDataModel import vtkPolyData
+from vtkmodules.vtkFiltersCore import vtkProbeFilter
+from vtkmodules.vtkIOXML import vtkXMLPUnstructuredGridReader
+from wedge_sweep import past_contact, read, sides, swept  # this folder's
+
+GAUSS = np.array([0.5 - 0.5 / np.sqrt(3.0), 0.5 + 0.5 / np.sqrt(3.0)])
+
+
+def fluid_velocity(path, points):
+    """The fluid's velocity (x, y) at `points` (n x 2) from one .pvtu of the fluid, and whether
+    each point lies in the fluid mesh."""
+    reader = vtkXMLPUnstructuredGridReader()
+    reader.SetFileName(str(path))
+    reader.Update()
+    probes = vtkPoints()
+    for x, y in points:
+        probes.InsertNextPoint(x, y, 0.0)
+    data = vtkPolyData()
+    data.SetPoints(probes)
+    probe = vtkProbeFilter()
+    probe.SetInputData(data)
+    probe.SetSourceData(reader.GetOutput())
+    probe.Update()
+    values = probe.GetOutput().GetPointData()
+    return (vtk_to_numpy(values.GetArray("velocity"))[:, :2],
+            vtk_to_numpy(values.GetArray(probe.GetValidPointMaskArrayName())) > 0)
+
+
+def main():
+    if len(sys.argv) != 2:
+        sys.exit(__doc__)
+    run = Path(sys.argv[1])
+    steps, rows = read_run(run)
+    fluid = [(float(d.get("timestep")), run / d.get("file"))
+             for d in ElementTree.parse(run / "solution.pvd").getroot().iter("DataSet")]
+    if not (len(steps) == len(rows) == len(fluid)
+            and all(abs(a[0] - b[0]) < 1e-12 for a, b in zip(steps, fluid))):
+        sys.exit(f"{run}: {len(steps)} solid and {len(fluid)} fluid fields for {len(rows)} steps: "
+                 f"write them at every step (--set output.vtk_interval=1)")
+    points, _, _, cells = read(steps[0][1])
+    facets, inner, lower_face, upper_face = sides(points, cells)
+
+    def fluxes(k, chosen):
+        """Per facet of `chosen`, in its place at the end of step k (at rest before step 0): the
+        fluxes of the fluid's and of the solid's velocity, and whether it lies in the fluid."""
+        if k < 0:
+            return np.zeros(len(chosen)), np.zeros(len(chosen)), np.ones(len(chosen), dtype=bool)
+        _, displacement, _, _, solid_velocity = read(steps[k][1], ("velocity",))
+        current = points + displacement
+        a, b = current[facets[chosen, 0]], current[facets[chosen, 1]]
+        edge = b - a
+        area_normal = np.stack([edge[:, 1], -edge[:, 0]], axis=1)  # |F| n, n out of the solid
+        velocity, inside = fluid_velocity(fluid[k][1], np.concatenate([a + g * edge for g in GAUSS]))
+        n = len(chosen)
+        fluid_flux = sum(np.einsum("ij,ij->i", velocity[q * n:(q + 1) * n], area_normal)
+                         for q in range(len(GAUSS))) / len(GAUSS)
+        # the solid's own velocity, linear on the facet: its mean times |F| n
+        mean_velocity = 0.5 * (solid_velocity[facets[chosen, 0]] + solid_velocity[facets[chosen, 1]])
+        return (fluid_flux, np.einsum("ij,ij->i", mean_velocity, area_normal),
+                inside.reshape(len(GAUSS), -1).all(axis=0))
+
+    previous = points.copy()  # the run starts at rest
+    phases = []
+    for k, ((time, path), row) in enumerate(zip(steps, rows)):
+        _, displacement, active, _ = read(path)
+        current = points + displacement
+        step = time - (rows[k - 1]["time"] if k else 0.0)
+        downstream, node = past_contact(points, current, active, facets, lower_face, upper_face)
+        if node is not None:
+            upstream = np.flatnonzero(inner & ~downstream)
+            fluid_end, solid_end, inside = fluxes(k, upstream)
+            fluid_start, solid_start, inside_start = fluxes(k - 1, upstream)
+            inside &= inside_start
+            sweep = swept(facets, previous, current)[upstream]
+            if not phases or phases[-1]["end"] != rows[k - 1]["time"]:
+                phases.append({"start": time, "Q": 0.0, "F": 0.0, "V": 0.0, "S": 0.0, "walls": 0.0,
+                               "leak": 0.0})
+            phase = phases[-1]
+            phase["end"] = time
+            flow_start = rows[k - 1]["outlet_flow_inlet"] if k else 0.0
+            phase["Q"] += 0.5 * (flow_start + row["outlet_flow_inlet"]) * step
+            phase["F"] += 0.5 * (fluid_start + fluid_end)[inside].sum() * step
+            phase["V"] += 0.5 * (solid_start + solid_end)[inside].sum() * step
+            phase["S"] += sweep[inside].sum()
+            phase["walls"] += sweep[~inside].sum()
+            phase["leak"] += row["leak_flow"] * step
+        previous = current
+    print(f"{run}: {len(steps)} steps, {len(phases)} closed phase(s); per phase [m^2]: the flow out "
+          f"through the inlet Q, the fluxes F of the fluid's and V of the solid's velocity through "
+          f"the upstream sides to the contact node, and their sweep S")
+    for p in phases:
+        print(f"closed {p['start']:.4f}-{p['end']:.4f} s: Q {p['Q']:+.3e}, F {p['F']:+.3e}, "
+              f"V {p['V']:+.3e}, S {p['S']:+.3e}; leak Q - S {p['Q'] - p['S']:+.3e} = slip F - S "
+              f"{p['F'] - p['S']:+.3e} + rest Q - F {p['Q'] - p['F']:+.3e}; slip = F - V "
+              f"{p['F'] - p['V']:+.3e} + V - S {p['V'] - p['S']:+.3e} (the benchmark's leak "
+              f"{p['leak']:+.3e}; the sweep of the sides' parts in the walls {p['walls']:+.1e})")
+
+
+if __name__ == "__main__":
+    main()
