@@ -232,28 +232,24 @@ def main():
         print(f"coupling iterations over 5 steps: IQN-ILS {iterations['iqn_ils']}, Aitken {iterations['aitken']}")
         r.expect(2 * iterations["iqn_ils"] < iterations["aitken"], "IQN-ILS needs fewer than half of Aitken's iterations")
 
-    result = r.run("run", r.source / "cases" / "valve2d.yaml", "--output", r.work / "bad",
-                   "--set", "benchmark.solid=valve")
-    r.expect(result.returncode == 2 and "benchmark.solid" in result.stderr,
-             "a valve benchmark without such a solid is an input error naming the key", result.stderr)
-    result = r.run("run", r.source / "cases" / "valve2d.yaml", "--output", r.work / "bad-surface",
-                   "--set", "benchmark.upstream_surfaces=[lower_inner, upper_side]")
-    r.expect(result.returncode == 2 and "benchmark.upstream_surfaces" in result.stderr
-             and "upper_side" in result.stderr and "upper_inner" in result.stderr,
+    # bad input: the option, what the message must name, and the check's description
+    for name, option, named, what in (
+            ("bad", "benchmark.solid=valve", ["benchmark.solid"],
+             "a valve benchmark without such a solid is an input error naming the key"),
+            ("bad-surface", "benchmark.upstream_surfaces=[lower_inner, upper_side]",
+             ["benchmark.upstream_surfaces", "upper_side", "upper_inner"],
              "an upstream surface the leaflets do not have is an input error naming the key, the "
-             "group and the groups there are", result.stderr)
-    result = r.run("run", r.source / "cases" / "valve2d.yaml", "--output", r.work / "bad-unclamped",
-                   "--set", "solids[0].dirichlet[1].boundary=lower_base")
-    r.expect(result.returncode == 2 and "benchmark.upstream_surfaces" in result.stderr
-             and "not joined to a clamped node" in result.stderr,
+             "group and the groups there are"),
+            ("bad-unclamped", "solids[0].dirichlet[1].boundary=lower_base",
+             ["benchmark.upstream_surfaces", "not joined to a clamped node"],
              "an upstream surface with a part not joined to a clamped node (the upper leaflet "
-             "unclamped) is an input error naming the key", result.stderr)
-    result = r.run("run", r.source / "cases" / "valve2d.yaml", "--output", r.work / "bad-downstream",
-                   "--set", "benchmark.downstream_boundary=outflow")
-    r.expect(result.returncode == 2 and "benchmark.downstream_boundary" in result.stderr
-             and "outflow" in result.stderr,
-             "a downstream boundary the fluid does not have is an input error naming the key and the "
-             "group", result.stderr)
+             "unclamped) is an input error naming the key"),
+            ("bad-downstream", "benchmark.downstream_boundary=outflow",
+             ["benchmark.downstream_boundary", "outflow"],
+             "a downstream boundary the fluid does not have is an input error naming the key and "
+             "the group")):
+        result = r.run("run", r.source / "cases" / "valve2d.yaml", "--output", r.work / name, "--set", option)
+        r.expect(result.returncode == 2 and all(text in result.stderr for text in named), what, result.stderr)
     r.finish()
 
 
