@@ -52,12 +52,17 @@ from wedge_sweep import past_contact, read, sides, swept  # this folder's
 GAUSS = np.array([0.5 - 0.5 / np.sqrt(3.0), 0.5 + 0.5 / np.sqrt(3.0)])
 
 
-def fluid_velocity(path, points):
-    """The fluid's velocity (x, y) at `points` (n x 2) from one .pvtu of the fluid, and whether
-    each point lies in the fluid mesh."""
+def read_fluid(path):
+    """The grid of one .pvtu of the fluid."""
     reader = vtkXMLPUnstructuredGridReader()
     reader.SetFileName(str(path))
     reader.Update()
+    return reader.GetOutput()
+
+
+def fluid_velocity(grid, points):
+    """The fluid's velocity (x, y) at `points` (n x 2) from a grid of read_fluid, and whether
+    each point lies in the fluid mesh."""
     probes = vtkPoints()
     for x, y in points:
         probes.InsertNextPoint(x, y, 0.0)
@@ -65,7 +70,7 @@ def fluid_velocity(path, points):
     data.SetPoints(probes)
     probe = vtkProbeFilter()
     probe.SetInputData(data)
-    probe.SetSourceData(reader.GetOutput())
+    probe.SetSourceData(grid)
     probe.Update()
     values = probe.GetOutput().GetPointData()
     return (vtk_to_numpy(values.GetArray("velocity"))[:, :2],
@@ -86,17 +91,17 @@ def main():
     points, _, _, cells = read(steps[0][1])
     facets, inner, lower_face, upper_face = sides(points, cells)
 
-    def fluxes(k, chosen):
-        """Per facet of `chosen`, in its place at the end of step k (at rest before step 0): the
-        fluxes of the fluid's and of the solid's velocity, and whether it lies in the fluid."""
-        if k < 0:
+    def fluxes(state, chosen):
+        """Per facet of `chosen`, in its place in `state` (its positions, the solid's velocity and
+        the fluid's grid; None: at rest before the first step): the fluxes of the fluid's and of
+        the solid's velocity, and whether it lies in the fluid."""
+        if state is None:
             return np.zeros(len(chosen)), np.zeros(len(chosen)), np.ones(len(chosen), dtype=bool)
-        _, displacement, _, _, solid_velocity = read(steps[k][1], ("velocity",))
-        current = points + displacement
+        current, solid_velocity, grid = state
         a, b = current[facets[chosen, 0]], current[facets[chosen, 1]]
         edge = b - a
         area_normal = np.stack([edge[:, 1], -edge[:, 0]], axis=1)  # |F| n, n out of the solid
-        velocity, inside = fluid_velocity(fluid[k][1], np.concatenate([a + g * edge for g in GAUSS]))
+        velocity, inside = fluid_velocity(grid, np.concatenate([a + g * edge for g in GAUSS]))
         n = len(chosen)
         fluid_flux = sum(np.einsum("ij,ij->i", velocity[q * n:(q + 1) * n], area_normal)
                          for q in range(len(GAUSS))) / len(GAUSS)
@@ -105,23 +110,29 @@ def main():
         return (fluid_flux, np.einsum("ij,ij->i", mean_velocity, area_normal),
                 inside.reshape(len(GAUSS), -1).all(axis=0))
 
-    previous = points.copy()  # the run starts at rest
+    previous = None  # (positions, solid velocity, fluid grid) at the last step's end
     phases = []
     for k, ((time, path), row) in enumerate(zip(steps, rows)):
-        _, displacement, active, _ = read(path)
-        current = points + displacement
+        _, displacement, active, _, solid_velocity = read(path, ("velocity",))
+        # the fluid's grid is read only where it is probed: the closed steps and the step before
+        state = [points + displacement, solid_velocity, None]
+        current = state[0]
         step = time - (rows[k - 1]["time"] if k else 0.0)
         downstream, node = past_contact(points, current, active, facets, lower_face, upper_face)
         if node is not None:
+            state[2] = read_fluid(fluid[k][1])
+            if previous is not None and previous[2] is None:
+                previous[2] = read_fluid(fluid[k - 1][1])
             upstream = np.flatnonzero(inner & ~downstream)
-            fluid_end, solid_end, inside = fluxes(k, upstream)
-            fluid_start, solid_start, inside_start = fluxes(k - 1, upstream)
+            fluid_end, solid_end, inside = fluxes(state, upstream)
+            fluid_start, solid_start, inside_start = fluxes(previous, upstream)
             inside &= inside_start
-            sweep = swept(facets, previous, current)[upstream]
+            start_positions, start_velocity = ((points, np.zeros_like(points)) if previous is None
+                                               else (previous[0], previous[1]))
+            sweep = swept(facets, start_positions, current)[upstream]
             # the nodes whose displacement is not the trapezoidal rule of their velocity
-            velocity_start = read(steps[k - 1][1], ("velocity",))[4] if k else np.zeros_like(points)
-            velocity_end = read(path, ("velocity",))[4]
-            mismatch = np.linalg.norm(current - previous - 0.5 * step * (velocity_start + velocity_end), axis=1)
+            mismatch = np.linalg.norm(current - start_positions
+                                      - 0.5 * step * (start_velocity + solid_velocity), axis=1)
             moved = (mismatch[facets[upstream, 0]] > 1e-12) | (mismatch[facets[upstream, 1]] > 1e-12)
             if not phases or phases[-1]["end"] != rows[k - 1]["time"]:
                 phases.append({"start": time, "Q": 0.0, "slip": 0.0, "slip moved": 0.0,
@@ -137,7 +148,7 @@ def main():
             phase["S"] += sweep[inside].sum()
             phase["walls"] += sweep[~inside].sum()
             phase["leak"] += row["leak_flow"] * step
-        previous = current
+        previous = state
     print(f"{run}: {len(steps)} steps, {len(phases)} closed phase(s); per phase [m^2]: the flow out "
           f"through the inlet Q and the sweep S of the upstream sides to the contact node")
     for p in phases:

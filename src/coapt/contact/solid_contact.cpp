@@ -74,16 +74,7 @@ double HertzParameters::contact_size() const {
 }
 
 std::vector<double> nominal_pressures(const PairState& pair) {
-  const auto& slave = pair.slave;
-  std::vector<double> reference_area(static_cast<std::size_t>(slave.n_nodes()), 0.0);
-  for (int f = 0; f < slave.n_facets(); ++f) {
-    const auto area_normal = facet_area_normal(slave, slave.reference, f);
-    const double share =
-        std::sqrt(area_normal[0] * area_normal[0] + area_normal[1] * area_normal[1] +
-                  area_normal[2] * area_normal[2]) /
-        slave.dim;
-    for (const int node : slave.facet(f)) reference_area[static_cast<std::size_t>(node)] += share;
-  }
+  const auto reference_area = nodal_measures(pair.slave, pair.slave.reference);
   std::vector<double> nominal(reference_area.size(), 0.0);
   for (std::size_t j = 0; j < nominal.size(); ++j)
     if (pair.pressure[j] != 0.0 && reference_area[j] > 0.0)

@@ -130,6 +130,16 @@ std::array<double, 3> facet_area_normal(const Surface& surface, std::span<const 
           0.5 * (e[0] * g[1] - e[1] * g[0])};
 }
 
+std::vector<double> nodal_measures(const Surface& surface, std::span<const double> x) {
+  std::vector<double> measures(static_cast<std::size_t>(surface.n_nodes()), 0.0);
+  for (int f = 0; f < surface.n_facets(); ++f) {
+    const auto a = facet_area_normal(surface, x, f);
+    const double share = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]) / surface.dim;
+    for (const int node : surface.facet(f)) measures[static_cast<std::size_t>(node)] += share;
+  }
+  return measures;
+}
+
 std::vector<double> nodal_normals(const Surface& surface, std::span<const double> x,
                                   std::vector<char>* valid, double min_alignment) {
   const int dim = surface.dim;

@@ -59,6 +59,10 @@ std::vector<char> boundary_nodes(const Surface& surface);
 /// 3D: half the cross product) at coordinates `x` (n_nodes × dim).
 std::array<double, 3> facet_area_normal(const Surface& surface, std::span<const double> x, int f);
 
+/// ∫ N_j over the surface at coordinates `x` (n_nodes × dim) for each node j: the sum of
+/// |F| / dim over its facets F [m^(dim−1)], one per node.
+std::vector<double> nodal_measures(const Surface& surface, std::span<const double> x);
+
 /// Averaged nodal normals at coordinates `x` (n_nodes × dim): the normalised sum of the
 /// measure-weighted normals of the node's facets (n_nodes × dim). A node whose facet normals
 /// nearly cancel (|Σ a_f n_f| < min_alignment Σ a_f: a thin edge or a fold, where no normal

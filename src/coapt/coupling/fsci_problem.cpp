@@ -537,9 +537,13 @@ class FsciProblem final : public run::Problem {
         downstream_tag_ =
             fluid_.boundary_tag(b.downstream_boundary, "benchmark.downstream_boundary");
       const auto& solid_mesh = find_solid(b.valve_solid)->mesh;
+      std::vector<int> upstream_tags;
       for (const auto& group : b.upstream_surfaces) {
         const auto* found = solid_mesh.find_group(group);
-        if (found && found->dim == solid_mesh.dim - 1) continue;
+        if (found && found->dim == solid_mesh.dim - 1) {
+          upstream_tags.push_back(found->tag);
+          continue;
+        }
         std::string names;
         for (const auto& g : solid_mesh.groups)
           if (g.dim == solid_mesh.dim - 1) names += (names.empty() ? "" : ", ") + g.name;
@@ -549,9 +553,9 @@ class FsciProblem final : public run::Problem {
       }
       if (!b.upstream_surfaces.empty()) {
         const auto& model = *find_solid(b.valve_solid)->model;
-        upstream_ = std::make_unique<UpstreamSurface>(model.mesh(), b.upstream_surfaces,
-                                                      model.dirichlet_dofs(), fluid_.mesh(),
-                                                      "benchmark.upstream_surfaces", b.valve_solid);
+        upstream_ = std::make_unique<UpstreamSurface>(
+            model.mesh(), upstream_tags, fmt::format("{}", fmt::join(b.upstream_surfaces, ", ")),
+            model.dirichlet_dofs(), fluid_.mesh(), "benchmark.upstream_surfaces", b.valve_solid);
       }
     }
     if (!b.probe.empty()) {
@@ -1534,15 +1538,12 @@ class FsciProblem final : public run::Problem {
     const auto* solid = find_solid(b.valve_solid);  // deformable: it has contact
     const auto& model = *solid->model;
     if (upstream_) {
-      const auto& pairs = solid->contact->constraints().pairs();
-      const auto counted = upstream_->counted_vertices(pairs);
-      const auto reached = upstream_->counted_vertices(pairs, false);
+      const auto levels = upstream_->vertex_levels(solid->contact->constraints().pairs());
       for (const auto& group : b.upstream_surfaces) {
-        const double in_fluid = model.surface_swept_volume(group, counted) / step;
-        const double upstream = model.surface_swept_volume(group, reached) / step;
-        swept_flow_ += in_fluid;
-        swept_outside_fluid_ += upstream - in_fluid;
-        swept_past_contact_ += model.surface_swept_volume(group) / step - upstream;
+        const auto swept = model.surface_swept_volumes(group, levels, UpstreamSurface::kLevels);
+        swept_flow_ += swept[UpstreamSurface::kCounted] / step;
+        swept_outside_fluid_ += swept[UpstreamSurface::kOutsideFluid] / step;
+        swept_past_contact_ += swept[UpstreamSurface::kPastContact] / step;
       }
     }
     const double volume = model.volume();

@@ -1,7 +1,6 @@
 #include "coapt/coupling/valve_surface.hpp"
 
 #include <fmt/format.h>
-#include <fmt/ranges.h>
 #include <mpi.h>
 
 #include <algorithm>
@@ -96,14 +95,8 @@ std::vector<PetscInt> contact_zone_vertices(const std::vector<contact::PairState
         zone.push_back(pair.slave.global_vertex[static_cast<std::size_t>(j)]);
     const auto& master = pair.master;
     if (pair.master_x.size() != static_cast<std::size_t>(master.n_nodes() * master.dim)) continue;
-    // ∫_Γm N_l = Σ over l's facets of |F| / (vertices per facet), at the current coordinates
-    std::vector<double> support(static_cast<std::size_t>(master.n_nodes()), 0.0);
-    for (int f = 0; f < master.n_facets(); ++f) {
-      const auto an = contact::facet_area_normal(master, pair.master_x, f);
-      const double measure = std::sqrt(an[0] * an[0] + an[1] * an[1] + an[2] * an[2]);
-      for (const int l : master.facet(f))
-        support[static_cast<std::size_t>(l)] += measure / master.dim;
-    }
+    // ∫_Γm N_l at the current coordinates
+    const auto support = contact::nodal_measures(master, pair.master_x);
     std::vector<double> covered(support.size(), 0.0);
     for (const auto& entry : pair.mortar.master_coupling)
       if (pair.active[static_cast<std::size_t>(entry.row)])
@@ -116,29 +109,12 @@ std::vector<PetscInt> contact_zone_vertices(const std::vector<contact::PairState
   return zone;
 }
 
-namespace {
-
-std::vector<int> boundary_tags(const mesh::Mesh& mesh, const std::vector<std::string>& groups,
-                               const std::string& key, const std::string& solid) {
-  std::vector<int> tags;
-  for (const auto& name : groups) {
-    const auto* group = mesh.find_group(name);
-    if (!group || group->dim != mesh.dim - 1)
-      throw InputError(fmt::format("{}: solid '{}' has no boundary group '{}'", key, solid, name));
-    tags.push_back(group->tag);
-  }
-  return tags;
-}
-
-}  // namespace
-
-UpstreamSurface::UpstreamSurface(const mesh::Mesh& mesh, const std::vector<std::string>& groups,
+UpstreamSurface::UpstreamSurface(const mesh::Mesh& mesh, std::span<const int> tags,
+                                 const std::string& groups,
                                  std::span<const PetscInt> dirichlet_dofs,
                                  const mesh::Mesh& fluid_mesh, const std::string& key,
                                  const std::string& solid)
-    : mesh_(mesh),
-      surface_(contact::gather_surface(mesh, boundary_tags(mesh, groups, key, solid),
-                                       fmt::format("{}", fmt::join(groups, ", ")))) {
+    : mesh_(mesh), surface_(contact::gather_surface(mesh, tags, groups)) {
   const int n_nodes = surface_.n_nodes();
   for (int node = 0; node < n_nodes; ++node)
     node_of_vertex_.emplace(surface_.global_vertex[static_cast<std::size_t>(node)], node);
@@ -169,8 +145,8 @@ UpstreamSurface::UpstreamSurface(const mesh::Mesh& mesh, const std::vector<std::
   }
 }
 
-std::vector<char> UpstreamSurface::counted_vertices(const std::vector<contact::PairState>& pairs,
-                                                    bool fluid_only) const {
+std::vector<char> UpstreamSurface::vertex_levels(
+    const std::vector<contact::PairState>& pairs) const {
   const auto n_nodes = static_cast<std::size_t>(surface_.n_nodes());
   std::vector<char> blocked(n_nodes, 0);
   for (const PetscInt vertex : contact_zone_vertices(pairs)) {
@@ -178,14 +154,15 @@ std::vector<char> UpstreamSurface::counted_vertices(const std::vector<contact::P
     if (found != node_of_vertex_.end()) blocked[static_cast<std::size_t>(found->second)] = 1;
   }
   const auto reached = reached_nodes(surface_, clamped_, blocked);
-  std::vector<char> counted(static_cast<std::size_t>(mesh_.n_vertices()), 0);
+  std::vector<char> levels(static_cast<std::size_t>(mesh_.n_vertices()), kPastContact);
   for (int v = 0; v < mesh_.n_vertices(); ++v) {
     const auto found = node_of_vertex_.find(mesh_.global_vertex[static_cast<std::size_t>(v)]);
-    if (found == node_of_vertex_.end()) continue;
-    const auto node = static_cast<std::size_t>(found->second);
-    counted[static_cast<std::size_t>(v)] = reached[node] && (in_fluid_[node] || !fluid_only);
+    if (found == node_of_vertex_.end() || !reached[static_cast<std::size_t>(found->second)])
+      continue;
+    levels[static_cast<std::size_t>(v)] =
+        in_fluid_[static_cast<std::size_t>(found->second)] ? kCounted : kOutsideFluid;
   }
-  return counted;
+  return levels;
 }
 
 }  // namespace coapt::coupling

@@ -56,22 +56,25 @@ std::vector<PetscInt> contact_zone_vertices(const std::vector<contact::PairState
 /// The upstream surfaces of a valve's solid and the clamped nodes their count starts from.
 class UpstreamSurface {
  public:
-  /// The boundary facets of `mesh` in the boundary groups `groups` (gathered on every rank);
-  /// the clamped nodes are those with a prescribed displacement component among
-  /// `dirichlet_dofs` (this rank's owned global dofs, interleaved: vertex · dim + component);
-  /// the nodes outside `fluid_mesh` (points_in_mesh, reference coordinates) count no facet.
-  /// InputError naming `key`, the groups and `solid` when a group is not a boundary group of
-  /// the mesh or a part of the surface is not joined to a clamped node. Collective.
-  UpstreamSurface(const mesh::Mesh& mesh, const std::vector<std::string>& groups,
+  /// The boundary facets of `mesh` with one of the facet tags `tags` (the boundary groups
+  /// named in `groups`, for messages), gathered on every rank; the clamped nodes are those
+  /// with a prescribed displacement component among `dirichlet_dofs` (this rank's owned global
+  /// dofs, interleaved: vertex · dim + component); the nodes outside `fluid_mesh`
+  /// (points_in_mesh, reference coordinates) count no facet. InputError naming `key`, the
+  /// groups and `solid` when a part of the surface is not joined to a clamped node. Collective.
+  UpstreamSurface(const mesh::Mesh& mesh, std::span<const int> tags, const std::string& groups,
                   std::span<const PetscInt> dirichlet_dofs, const mesh::Mesh& fluid_mesh,
                   const std::string& key, const std::string& solid);
 
-  /// Per local vertex of the mesh (owned and ghost): 1 on the nodes in R for the contact zone
-  /// of `pairs` (every surface node without contact) that lie in the fluid mesh (all of them
-  /// with `fluid_only` false), 0 elsewhere. A
-  /// facet of the upstream surfaces is counted when one of its vertices is flagged. Not collective.
-  std::vector<char> counted_vertices(const std::vector<contact::PairState>& pairs,
-                                     bool fluid_only = true) const;
+  /// Per local vertex of the mesh (owned and ghost) its level for
+  /// SolidModel::surface_swept_volumes, for the contact zone of `pairs`: kCounted on the nodes
+  /// in R (every surface node without contact) that lie in the fluid mesh, kOutsideFluid on
+  /// the other nodes in R, kPastContact elsewhere. A facet of the upstream surfaces takes the
+  /// largest level of its vertices, so it counts when one of its nodes is in R and in the
+  /// fluid. Not collective.
+  std::vector<char> vertex_levels(const std::vector<contact::PairState>& pairs) const;
+  /// The levels of vertex_levels (kLevels of them).
+  enum Level : char { kPastContact = 0, kOutsideFluid = 1, kCounted = 2, kLevels = 3 };
 
  private:
   const mesh::Mesh& mesh_;

@@ -617,12 +617,14 @@ class SolidModelImpl {
     return motions;
   }
 
-  double surface_swept_volume(const std::string& boundary,
-                              std::span<const char> counted_vertices) const {
+  /// surface_swept_volumes; empty `vertex_levels`: every facet at level 0.
+  std::vector<double> surface_swept_volumes(const std::string& boundary,
+                                            std::span<const char> vertex_levels,
+                                            int n_levels) const {
     const int tag = facet_tag(boundary, "surface_swept_volume");
-    if (!counted_vertices.empty() && counted_vertices.size() != mesh_.global_vertex.size())
-      throw Error(fmt::format("surface_swept_volume: {} vertex flags for {} vertices",
-                              counted_vertices.size(), mesh_.global_vertex.size()));
+    if (!vertex_levels.empty() && vertex_levels.size() != mesh_.global_vertex.size())
+      throw InternalError(fmt::format("surface_swept_volume: {} vertex levels for {} vertices",
+                                      vertex_levels.size(), mesh_.global_vertex.size()));
     fem::update_ghosts(u_committed_.get());
     fem::update_ghosts(u_.get());
     fem::LocalValues start(u_committed_.get()), end(u_.get());
@@ -649,13 +651,16 @@ class SolidModelImpl {
       an[1] = 0.5 * (e1[2] * e2[0] - e1[0] * e2[2]);
       an[2] = 0.5 * (e1[0] * e2[1] - e1[1] * e2[0]);
     };
-    double volume = 0;
+    std::vector<double> volumes(static_cast<std::size_t>(n_levels), 0.0);
     for (int f = 0; f < mesh_.n_facets(); ++f) {
       if (mesh_.facet_tags[f] != tag || mesh_.facet_cell[f] >= mesh_.n_owned_cells) continue;
       const int* v = mesh_.facets.data() + static_cast<std::size_t>(f) * d;
-      if (!counted_vertices.empty() &&
-          std::none_of(v, v + d, [&](int a) { return counted_vertices[a] != 0; }))
-        continue;
+      int level = 0;
+      if (!vertex_levels.empty())
+        for (int a = 0; a < dim_; ++a) level = std::max(level, int{vertex_levels[v[a]]});
+      if (level < 0 || level >= n_levels)
+        throw InternalError(fmt::format("surface_swept_volume: level {} of {}", level, n_levels));
+      double& volume = volumes[static_cast<std::size_t>(level)];
       // Along the path every point of the facet moves by the P1 interpolant of the vertices'
       // moves, constant in tau, and the facet stays flat, so ∫_F Δx·n da = (mean Δx)·|F|n(tau).
       // |F|n is linear in tau in 2D and quadratic in 3D: the midpoint rule, resp. Simpson's
@@ -675,8 +680,8 @@ class SolidModelImpl {
       }
       for (int i = 0; i < dim_; ++i) volume += mean_move[i] * path[i];
     }
-    MPI_Allreduce(MPI_IN_PLACE, &volume, 1, MPI_DOUBLE, MPI_SUM, comm_);
-    return volume;
+    MPI_Allreduce(MPI_IN_PLACE, volumes.data(), n_levels, MPI_DOUBLE, MPI_SUM, comm_);
+    return volumes;
   }
 
   std::vector<double> current_coordinates() const {
@@ -1883,9 +1888,13 @@ std::array<double, 9> SolidModel::mean_cauchy_stress() const {
 std::vector<double> SolidModel::reaction_force(const std::string& boundary) const {
   return impl_->reaction_force(boundary);
 }
-double SolidModel::surface_swept_volume(const std::string& boundary,
-                                        std::span<const char> counted_vertices) const {
-  return impl_->surface_swept_volume(boundary, counted_vertices);
+double SolidModel::surface_swept_volume(const std::string& boundary) const {
+  return impl_->surface_swept_volumes(boundary, {}, 1)[0];
+}
+std::vector<double> SolidModel::surface_swept_volumes(const std::string& boundary,
+                                                      std::span<const char> vertex_levels,
+                                                      int n_levels) const {
+  return impl_->surface_swept_volumes(boundary, vertex_levels, n_levels);
 }
 std::vector<double> SolidModel::current_coordinates() const {
   return impl_->current_coordinates();

@@ -230,11 +230,15 @@ class SolidModel {
   /// whole boundary it is the change of volume(). Divided by Δt it is the rate at which that
   /// surface sweeps the space outside the body over the step, in step with the displacement
   /// (the trial velocity's flux ∫ v·n da need not be: contact-stabilized Newmark corrects u
-  /// without v). `counted_vertices` (per local vertex, owned and ghost; empty: all): only the
-  /// group's facets with a flagged vertex count. InputError when the group does not exist.
-  /// Collective.
-  double surface_swept_volume(const std::string& boundary,
-                              std::span<const char> counted_vertices = {}) const;
+  /// without v). InputError when the group does not exist. Collective.
+  double surface_swept_volume(const std::string& boundary) const;
+  /// The same volume split by level, in one pass: `vertex_levels` gives each local vertex
+  /// (owned and ghost) a level in [0, n_levels), a facet takes the largest level of its
+  /// vertices, and entry l is the volume the group's facets of level l sweep (n_levels
+  /// entries). Collective.
+  std::vector<double> surface_swept_volumes(const std::string& boundary,
+                                            std::span<const char> vertex_levels,
+                                            int n_levels) const;
   /// The current coordinates X + u of the local vertices (owned and ghost), row-major.
   std::vector<double> current_coordinates() const;
 
