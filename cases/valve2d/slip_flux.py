@@ -88,7 +88,8 @@ def main():
             and all(abs(a[0] - b[0]) < 1e-12 for a, b in zip(steps, fluid))):
         sys.exit(f"{run}: {len(steps)} solid and {len(fluid)} fluid fields for {len(rows)} steps: "
                  f"write them at every step (--set output.vtk_interval=1)")
-    points, _, _, cells = read(steps[0][1])
+    first = read(steps[0][1], ("velocity",))
+    points, cells = first[0], first[3]
     facets, inner, lower_face, upper_face = sides(points, cells)
 
     def fluxes(state, chosen):
@@ -113,7 +114,8 @@ def main():
     previous = None  # (positions, solid velocity, fluid grid) at the last step's end
     phases = []
     for k, ((time, path), row) in enumerate(zip(steps, rows)):
-        _, displacement, active, _, solid_velocity = read(path, ("velocity",))
+        fields = first if k == 0 else read(path, ("velocity",))
+        _, displacement, active, _, solid_velocity = fields
         # the fluid's grid is read only where it is probed: the closed steps and the step before
         state = [points + displacement, solid_velocity, None]
         current = state[0]

@@ -120,12 +120,13 @@ def main():
     if len(steps) != len(rows):
         sys.exit(f"{run}: {len(steps)} solid fields for {len(rows)} steps: write them at every "
                  f"step (--set output.vtk_interval=1)")
-    points, displacement, _, cells = read(steps[0][1])
+    first = read(steps[0][1])
+    points, cells = first[0], first[3]
     facets, inner, lower_face, upper_face = sides(points, cells)
     previous = points.copy()  # the run starts at rest
     phases, worst = [], 0.0
     for k, ((time, path), row) in enumerate(zip(steps, rows)):
-        _, displacement, active, _ = read(path)
+        _, displacement, active, _ = first if k == 0 else read(path)
         current = points + displacement
         step = time - (rows[k - 1]["time"] if k else 0.0)
         sweep = swept(facets, previous, current)

@@ -1570,7 +1570,8 @@ class FsciProblem final : public run::Problem {
         smallest = std::min(smallest, valve_.opening[k]);
       }
       if (!valve_.closed[k]) continue;
-      const double dt = k > 0 ? valve_.times[k] - valve_.times[k - 1] : 0.0;
+      // the run starts at t = 0 (fluid_.start): the first record ends the step from there
+      const double dt = valve_.times[k] - (k > 0 ? valve_.times[k - 1] : 0.0);
       if (k == 0 || !valve_.closed[k - 1]) {
         leak.push_back(0.0);
         leak_downstream.push_back(0.0);
@@ -1656,7 +1657,10 @@ class FsciProblem final : public run::Problem {
         for (int i = 0; i < dim; ++i)
           series.add(fmt::format("{}_{}_u{}", name, names[k].name, axes[i]), probes[k][i]);
       series.add("kinetic_energy_" + name, solid->model->kinetic_energy());
-      series.add("volume_" + name, solid->model->volume());
+      // a transient valve's solid: its volume at this commit, which measure_swept_flow took
+      const bool valve_volume = parameters_.benchmark.type == "valve" && !parameters_.time.steady &&
+                                name == parameters_.benchmark.valve_solid;
+      series.add("volume_" + name, valve_volume ? valve_volume_ : solid->model->volume());
       if (!solid->contact) continue;
       solid->contact->add_series(output, "_" + name);
       const auto& pairs = solid->contact->constraints().pairs();

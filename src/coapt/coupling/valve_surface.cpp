@@ -9,6 +9,7 @@
 
 #include "coapt/core/error.hpp"
 #include "coapt/transfer/geometry.hpp"
+#include "coapt/transfer/search.hpp"
 
 namespace coapt::coupling {
 
@@ -18,30 +19,39 @@ template <int dim>
 void mark_points_in_mesh(const mesh::Mesh& mesh, std::span<const double> points,
                          std::vector<int>& inside) {
   constexpr double tolerance = 1e-9;  // barycentric: relative to the cell's size
-  const auto n_points = static_cast<int>(inside.size());
-  // the points sorted by x, so that each cell visits only those within its x range
-  std::vector<int> order(static_cast<std::size_t>(n_points));
-  for (int p = 0; p < n_points; ++p) order[static_cast<std::size_t>(p)] = p;
-  const auto x = [&](int p) { return points[static_cast<std::size_t>(p) * dim]; };
-  std::sort(order.begin(), order.end(), [&](int a, int b) { return x(a) < x(b); });
+  // the owned cells' boxes, widened by the tolerance, in a uniform grid: each point visits
+  // only the cells whose box holds it (linear in cells and points, in 2D and 3D alike)
+  std::vector<transfer::Simplex<dim>> simplices;
+  std::vector<transfer::Box<dim>> boxes;
+  simplices.reserve(static_cast<std::size_t>(mesh.n_owned_cells));
+  boxes.reserve(static_cast<std::size_t>(mesh.n_owned_cells));
   for (int c = 0; c < mesh.n_owned_cells; ++c) {
     std::array<transfer::Point<dim>, dim + 1> vertices;
     const auto cell = mesh.cell(c);
     for (int a = 0; a <= dim; ++a)
       for (int i = 0; i < dim; ++i) vertices[a][i] = mesh.point(cell[a])[i];
-    const auto simplex = transfer::make_simplex<dim>(vertices);
-    if (simplex.degenerate()) continue;
-    const double margin = tolerance * (simplex.box_upper[0] - simplex.box_lower[0]) + 1e-300;
-    auto p = std::lower_bound(order.begin(), order.end(), simplex.box_lower[0] - margin,
-                              [&](int q, double value) { return x(q) < value; });
-    for (; p != order.end() && x(*p) <= simplex.box_upper[0] + margin; ++p) {
-      if (inside[static_cast<std::size_t>(*p)]) continue;
-      transfer::Point<dim> point;
-      for (int i = 0; i < dim; ++i) point[i] = points[static_cast<std::size_t>(*p) * dim + i];
+    simplices.push_back(transfer::make_simplex<dim>(vertices));
+    const auto& simplex = simplices.back();
+    double extent = 0;
+    for (int i = 0; i < dim; ++i)
+      extent = std::max(extent, simplex.box_upper[i] - simplex.box_lower[i]);
+    boxes.push_back(simplex.degenerate()
+                        ? transfer::Box<dim>::empty()
+                        : transfer::Box<dim>::of(simplex).inflated(tolerance * extent + 1e-300));
+  }
+  transfer::BoxGrid<dim> grid;
+  grid.build(boxes);
+  for (std::size_t p = 0; p < inside.size(); ++p) {
+    transfer::Point<dim> point;
+    for (int i = 0; i < dim; ++i) point[i] = points[p * dim + static_cast<std::size_t>(i)];
+    const transfer::Box<dim> at{point, point};
+    grid.query(at, [&](int c) {
+      if (inside[p]) return;
+      const auto& simplex = simplices[static_cast<std::size_t>(c)];
       bool in = true;
       for (int a = 0; a <= dim && in; ++a) in = simplex.barycentric(a, point) >= -tolerance;
-      if (in) inside[static_cast<std::size_t>(*p)] = 1;
-    }
+      if (in) inside[p] = 1;
+    });
   }
 }
 

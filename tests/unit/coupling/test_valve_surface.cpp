@@ -109,5 +109,30 @@ TEST(ValveSurface, PointsInMeshIncludeItsBoundary) {
   EXPECT_EQ(points_in_mesh(box, points3), (std::vector<char>{1, 1, 0}));
 }
 
+TEST(ValveSurface, PointsInMeshFindTheCellOfEveryPointOfAFineMesh) {
+  // 6 x 5 x 4 boxes of 6 tetrahedra, 1000 points in a box 20 % larger on every side: a point
+  // is in the mesh exactly when it is in [0, 1.2] x [0, 1] x [0, 0.8] (none lies within
+  // 1e-9 of a face), whichever of the grid's bins holds it
+  const auto box = mesh::structured_box(0.0, 0.0, 0.0, 1.2, 1.0, 0.8, 6, 5, 4);
+  const double upper[3] = {1.2, 1.0, 0.8};
+  std::vector<double> points;
+  std::vector<char> expected;
+  unsigned state = 12345;
+  const auto uniform = [&state] {  // a fixed linear congruential sequence in [0, 1)
+    state = state * 1103515245u + 12345u;
+    return static_cast<double>((state >> 8) & 0xffffu) / 65536.0;
+  };
+  for (int p = 0; p < 1000; ++p) {
+    bool in = true;
+    for (int i = 0; i < 3; ++i) {
+      const double x = upper[i] * (1.4 * uniform() - 0.2);
+      points.push_back(x);
+      in = in && x >= 0.0 && x <= upper[i];
+    }
+    expected.push_back(in ? 1 : 0);
+  }
+  EXPECT_EQ(points_in_mesh(box, points), expected);
+}
+
 }  // namespace
 }  // namespace coapt::coupling
