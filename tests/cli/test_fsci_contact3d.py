@@ -15,6 +15,9 @@ valve's leaflets need it.
  - the flaps bend together: the back flap's tip u_x is within 5 % of the front flap's at every
    step (measured 0.2 %), and both grow;
  - the flaps' volume changes by less than 1e-3;
+ - the force on each flap (series.csv's force_x_flaps_front and _back: the part of B^T lambda on
+   its vertices) sums to the force on the solid (1e-12 relative), both are positive (the flow
+   pushes both downstream) and grow;
  - the contact acts: the same case without its contact pair (1 rank) lets the front flap's
    downstream face pass into the back flap (at the middle of the top edge its u_x exceeds the
    back flap's upstream face's by 15 um at t = 0.2 s); with the pair the front flap's tip moves
@@ -32,7 +35,8 @@ from cli_common import Runner, parse_arguments, run_with_series
 STEPS = {1: 4, 2: 4, 3: 2}  # per rank count
 DIRECT = ["-fluid_ksp_type", "preonly", "-fluid_pc_type", "lu", "-fluid_pc_factor_mat_solver_type", "mumps"]
 VOLUME = 2 * 0.04 * 0.2 * 0.2  # two flaps of 0.04 x 0.2 x 0.2 m, m^3
-COMPARED = ("flaps_front_tip_ux", "flaps_back_tip_ux", "force_x_flaps", "contact_force_x_flaps")
+COMPARED = ("flaps_front_tip_ux", "flaps_back_tip_ux", "force_x_flaps", "force_x_flaps_front",
+            "contact_force_x_flaps")
 
 
 def increasing(values):
@@ -76,6 +80,14 @@ def main():
         r.expect(increasing(front) and increasing(back) and apart < 0.05,
                  f"{ranks} rank(s): the flaps bend downstream together (tips within {apart:.1e} < 5 %)")
         r.expect(volume_change < 1e-3, f"{ranks} rank(s): flaps' volume change {volume_change:.1e} < 1e-3")
+        parts = max(abs(row[f"force_{a}_flaps_front"] + row[f"force_{a}_flaps_back"] - row[f"force_{a}_flaps"])
+                    / abs(row["force_x_flaps"]) for row in rows for a in "xyz")
+        r.expect(parts < 1e-12, f"{ranks} rank(s): the flaps' forces sum to the solid's ({parts:.1e} < 1e-12)")
+        r.expect(increasing([row["force_x_flaps_front"] for row in rows])
+                 and increasing([row["force_x_flaps_back"] for row in rows]),
+                 f"{ranks} rank(s): the flow pushes both flaps downstream, harder at every step")
+        r.expect(set(summary["benchmark"]["solids"]["flaps"]["body_forces"]) == {"front", "back"},
+                 f"{ranks} rank(s): summary.json has the force on each body")
     for ranks in (2, 3):
         if 1 in rows_of and ranks in rows_of:
             difference = max(abs(other[k] / one[k] - 1) for one, other in zip(rows_of[1], rows_of[ranks])

@@ -1504,6 +1504,43 @@ class FsciProblem final : public run::Problem {
     }
   }
 
+  /// Per body of a deformable solid with several bodies: the part of Bᵀλ (solid.force) on its
+  /// vertices, per component; a vertex that several bodies share gives each an equal part, so
+  /// the parts sum to total_force. Empty for a solid of one body. Collective.
+  std::vector<std::vector<double>> body_forces(const Solid& solid) const {
+    if (!solid.model || solid.model->parameters().bodies.size() < 2) return {};
+    const auto& mesh = solid.model->mesh();
+    const auto& body_of_cell = solid.model->body_of_cell();
+    const auto n_bodies = solid.model->parameters().bodies.size();
+    const auto dim = static_cast<std::size_t>(mesh.dim);
+    // the bodies of each owned vertex's cells: the ghost layer holds every cell of an owned
+    // vertex, so every rank count finds the same
+    std::vector<std::vector<int>> bodies(static_cast<std::size_t>(mesh.n_owned_vertices));
+    for (int c = 0; c < mesh.n_cells(); ++c)
+      for (const int vertex : mesh.cell(c)) {
+        if (vertex >= mesh.n_owned_vertices) continue;
+        auto& list = bodies[static_cast<std::size_t>(vertex)];
+        const int body = body_of_cell[static_cast<std::size_t>(c)];
+        if (std::find(list.begin(), list.end(), body) == list.end()) list.push_back(body);
+      }
+    std::vector<double> sums(n_bodies * dim, 0.0);
+    const PetscScalar* values = nullptr;
+    COAPT_PETSC_CHECK(VecGetArrayRead(solid.force, &values));
+    for (std::size_t v = 0; v < bodies.size(); ++v)
+      for (const int body : bodies[v])
+        for (std::size_t i = 0; i < dim; ++i)
+          sums[static_cast<std::size_t>(body) * dim + i] +=
+              values[v * dim + i] / static_cast<double>(bodies[v].size());
+    COAPT_PETSC_CHECK(VecRestoreArrayRead(solid.force, &values));
+    MPI_Allreduce(MPI_IN_PLACE, sums.data(), static_cast<int>(sums.size()), MPI_DOUBLE, MPI_SUM,
+                  mesh.comm);
+    std::vector<std::vector<double>> forces(n_bodies);
+    for (std::size_t b = 0; b < n_bodies; ++b)
+      forces[b].assign(sums.begin() + static_cast<std::ptrdiff_t>(b * dim),
+                       sums.begin() + static_cast<std::ptrdiff_t>((b + 1) * dim));
+    return forces;
+  }
+
   /// The valve benchmark's history: per recorded step the opening (the distance between the
   /// surfaces of the solid's first contact pair), whether it is closed (active contact nodes),
   /// the flow out through benchmark.flow_boundary and the largest penetration.
@@ -1647,6 +1684,12 @@ class FsciProblem final : public run::Problem {
       static constexpr const char* axes[] = {"x", "y", "z"};
       for (int i = 0; i < dim; ++i)
         series.add(fmt::format("force_{}_{}", axes[i], name), solid->total_force[i]);
+      const auto per_body = body_forces(*solid);
+      for (std::size_t b = 0; b < per_body.size(); ++b)
+        for (int i = 0; i < dim; ++i)
+          series.add(fmt::format("force_{}_{}_{}", axes[i], name,
+                                 solid->model->parameters().bodies[b].name),
+                     per_body[b][static_cast<std::size_t>(i)]);
       series.add("constrained_" + name, static_cast<double>(solid->constraint->n_constrained()));
       if (partial_coverage())
         series.add("partial_" + name, static_cast<double>(solid->constraint->n_partial()));
@@ -1724,6 +1767,12 @@ class FsciProblem final : public run::Problem {
       log::info("solid '{}': {} constrained fluid vertices, force ({:.8e}) {}", solid->entry->name,
                 solid->constraint->n_constrained(), fmt::join(solid->total_force, ", "),
                 force_unit);
+      const auto per_body = body_forces(*solid);
+      for (std::size_t b = 0; b < per_body.size(); ++b) {
+        const auto& body = solid->model->parameters().bodies[b].name;
+        entry["body_forces"][body] = io::Json::array_of(per_body[b]);
+        log::info("  body '{}': force ({:.8e}) {}", body, fmt::join(per_body[b], ", "), force_unit);
+      }
     }
     log::info("force balance: max |sum B^T lambda - sum reactions| / |sum reactions| = {:.3e}",
               force_balance_);
