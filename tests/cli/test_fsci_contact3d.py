@@ -86,7 +86,7 @@ def main():
         r.expect(increasing([row["force_x_flaps_front"] for row in rows])
                  and increasing([row["force_x_flaps_back"] for row in rows]),
                  f"{ranks} rank(s): the flow pushes both flaps downstream, harder at every step")
-        r.expect(set(summary["benchmark"]["solids"]["flaps"]["body_forces"]) == {"front", "back"},
+        r.expect(set(b["solids"]["flaps"]["body_forces"]) == {"front", "back"},
                  f"{ranks} rank(s): summary.json has the force on each body")
     for ranks in (2, 3):
         if 1 in rows_of and ranks in rows_of:

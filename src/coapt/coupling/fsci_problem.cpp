@@ -65,6 +65,12 @@ struct CouplingSettings {
   int reuse_steps = 8;   ///< iqn_ils: converged steps whose columns are reused
   int max_columns = 60;  ///< iqn_ils: columns at most
   double filter = 1e-8;  ///< iqn_ils: QR filter
+  /// iqn_ils: the change of the contact's active set within a step (|A Δ A₀| / |A ∪ A₀|)
+  /// above which the past steps' columns are no longer used (1: always used)
+  double contact_change = 1.0;
+  /// transient: a deformable solid's Newton in a step's later iterations starts from its last
+  /// iterate's state (SolidModel::step, from_current)
+  bool solid_warm_start = false;
   int retries = 2;       ///< stronger relaxation, then (transient) halved steps
   int freeze_after = 0;  ///< keep the constrained sets from this iteration of a step on (0: never)
   double iteration_density = 0;  ///< transient: the solids' iteration inertia [kg/m³] (0: none)
@@ -239,6 +245,21 @@ Parameters read(const config::Section& root) {
       "filter", 1e-8,
       {"", "iqn_ils: drop a column whose part orthogonal to the newer ones is below this fraction",
        Bounds{0.0, 1.0, false, false}});
+  c.contact_change = iteration.get<double>(
+      "drop_reused_above_contact_change", 1.0,
+      {"",
+       "iqn_ils: stop using the past steps' columns for the rest of a step (and forget them) "
+       "once an iterate's contact active set differs from the step's start A0 by more than "
+       "this fraction, |A - A0| + |A0 - A| over |A or A0| (the past iterates were taken with "
+       "another active set; 1: never)",
+       Bounds::closed(0.0, 1.0)});
+  c.solid_warm_start = iteration.get<bool>(
+      "solid_warm_start", false,
+      {"",
+       "transient: from a step's second coupling iteration on, start each deformable solid's "
+       "Newton from its last iterate's state instead of the predictor when its residual is "
+       "smaller (the tolerance stays relative to the predictor's residual; false: always the "
+       "predictor)"});
   c.iteration_density = iteration.get<double>(
       "iteration_density", 0.0,
       {"kg/m^3",
@@ -1175,7 +1196,8 @@ class FsciProblem final : public run::Problem {
                   fmt::format("solid '{}', coupling iteration {}", solid->entry->name, iteration),
                   false);
             else
-              solid->model->step(time, dt, output);
+              solid->model->step(time, dt, output,
+                                 c.solid_warm_start && iteration > 1 && !fell_back);
           } catch (const ConvergenceError& error) {
             // A quasi-Newton force can overshoot where the map is not smooth (the set of
             // constrained fluid nodes changes as the solid moves): fall back once to the
@@ -1208,6 +1230,16 @@ class FsciProblem final : public run::Problem {
         continue;
       }
       fell_back = false;
+      if (quasi_newton_ && !quasi_newton_->reused_dropped() && c.contact_change < 1) {
+        const double change = contact_change();
+        if (change > c.contact_change) {
+          log::debug(
+              "fsci: coupling iteration {}: the contact's active set changed by {:.2f} "
+              "since the step's start; the past steps' IQN-ILS columns are dropped",
+              iteration, change);
+          quasi_newton_->drop_reused();
+        }
+      }
       apply_constraint(steady);  // (3)
       {
         ScopedTimer timer(output.timers(), "fluid");
@@ -1313,6 +1345,28 @@ class FsciProblem final : public run::Problem {
               quasi_newton_ ? fmt::format("IQN-ILS, {} column(s) in the last update", last_columns_)
                             : fmt::format("omega {:.3f}", fmt::join(report.relaxation, ", ")));
     return result;
+  }
+
+  /// How far the solids' contact active sets A moved from their committed A₀ (the step's
+  /// start): |A Δ A₀| / |A ∪ A₀| over every pair (0 when both are empty). The pair states are
+  /// the same on every rank.
+  double contact_change() const {
+    std::size_t changed = 0, either = 0;
+    for (const auto& solid : solids_) {
+      if (!solid->contact || !solid->committed.contact) continue;
+      const auto& now = solid->contact->constraints().pairs();
+      const auto& start = solid->committed.contact->constraints.pairs;
+      for (std::size_t p = 0; p < now.size() && p < start.size(); ++p) {
+        const auto& a = now[p].active;
+        const auto& a0 = start[p].active;
+        for (std::size_t j = 0; j < std::max(a.size(), a0.size()); ++j) {
+          const bool in = j < a.size() && a[j], in0 = j < a0.size() && a0[j];
+          changed += in != in0 ? 1 : 0;
+          either += in || in0 ? 1 : 0;
+        }
+      }
+    }
+    return either > 0 ? static_cast<double>(changed) / static_cast<double>(either) : 0.0;
   }
 
   /// Σ_v (w_v x_v)² over the solid's vertices (w = pressure_weight), for a one-component

@@ -23,6 +23,11 @@ void InterfaceQuasiNewton::begin_step() {
   current_ = Columns{};
   last_residual_.clear();
   last_x_tilde_.clear();
+  reused_dropped_ = false;
+}
+
+void InterfaceQuasiNewton::drop_reused() {
+  reused_dropped_ = true;
 }
 
 void InterfaceQuasiNewton::reset() {
@@ -32,6 +37,8 @@ void InterfaceQuasiNewton::reset() {
 
 void InterfaceQuasiNewton::end_step() {
   if (reuse_steps_ <= 0) return;
+  if (reused_dropped_) previous_.clear();
+  reused_dropped_ = false;
   if (!current_.v.empty()) previous_.push_front(std::move(current_));
   while (static_cast<int>(previous_.size()) > reuse_steps_) previous_.pop_back();
   current_ = Columns{};
@@ -67,11 +74,12 @@ int InterfaceQuasiNewton::next(std::span<const double> x, std::span<const double
     v_columns.push_back(&current_.v[k]);
     w_columns.push_back(&current_.w[k]);
   }
-  for (const auto& step : previous_)
-    for (auto k = step.v.size(); k-- > 0;) {
-      v_columns.push_back(&step.v[k]);
-      w_columns.push_back(&step.w[k]);
-    }
+  if (!reused_dropped_)
+    for (const auto& step : previous_)
+      for (auto k = step.v.size(); k-- > 0;) {
+        v_columns.push_back(&step.v[k]);
+        w_columns.push_back(&step.w[k]);
+      }
   if (static_cast<int>(v_columns.size()) > max_columns_) {
     v_columns.resize(static_cast<std::size_t>(max_columns_));
     w_columns.resize(static_cast<std::size_t>(max_columns_));

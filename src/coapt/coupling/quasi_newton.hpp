@@ -44,6 +44,12 @@ class InterfaceQuasiNewton {
   /// Forgets every column, this step's and the past steps' (a step that failed: the past
   /// iterates may no longer describe the map).
   void reset();
+  /// Stops using the past steps' columns for the rest of this step, and forgets them when the
+  /// step converges (the map changed in this step, e.g. the contact's active set: the past
+  /// iterates describe another map).
+  void drop_reused();
+  /// Whether drop_reused() was called in this step.
+  bool reused_dropped() const { return reused_dropped_; }
 
   /// The columns of one step: V and W, this rank's entries.
   struct Columns {
@@ -63,6 +69,7 @@ class InterfaceQuasiNewton {
   Columns current_;
   std::deque<Columns> previous_;  ///< newest first
   std::vector<double> last_residual_, last_x_tilde_;
+  bool reused_dropped_ = false;  ///< drop_reused() in this step
 };
 
 }  // namespace coapt::coupling

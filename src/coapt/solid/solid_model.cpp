@@ -431,10 +431,14 @@ class SolidModelImpl {
     commit();
   }
 
-  StepReport step(double time, double time_step, run::RunOutput& output) {
+  StepReport step(double time, double time_step, run::RunOutput& output, bool from_current) {
     if (!mass_) throw InternalError("solid: step() before initialize_dynamics()");
     const Newmark scheme{time_step};
     const std::string label = fmt::format("time step to t = {:g} s", time);
+    if (from_current) {
+      if (!warm_start_) COAPT_PETSC_CHECK(VecDuplicate(u_, warm_start_.out()));
+      COAPT_PETSC_CHECK(VecCopy(u_, warm_start_));
+    }
     if (parameters_.time.contact_stabilized) {
       // Contact-stabilized predictor: the increment δ = Δt vₙ, projected by the hook onto
       // the admissible set (no penetration at uₙ + δ); Newton starts from uₙ + δ.
@@ -471,6 +475,22 @@ class SolidModelImpl {
       norm = residual_norm();
     }
     report.history.push_back(norm);
+    if (from_current) {
+      // The last solve's state instead, if nearer: history.front() stays the predictor's
+      // residual, which the tolerance is relative to.
+      if (!predicted_) COAPT_PETSC_CHECK(VecDuplicate(u_, predicted_.out()));
+      COAPT_PETSC_CHECK(VecCopy(u_, predicted_));
+      COAPT_PETSC_CHECK(VecCopy(warm_start_, u_));
+      fem::update_ghosts(u_);
+      const double warm = residual_norm();
+      if (std::isfinite(warm) && warm < norm) {
+        report.history.push_back(warm);
+      } else {
+        COAPT_PETSC_CHECK(VecCopy(predicted_, u_));
+        fem::update_ghosts(u_);
+        residual_norm();
+      }
+    }
     newton_solve(
         output, report, [&] { assemble_tangent(u_.get(), scheme.mass_factor()); }, residual_norm,
         label, "use a smaller time step", false);
@@ -1763,7 +1783,8 @@ class SolidModelImpl {
   OwnedVec residual_, inertia_;
   // contact-stabilized Newmark: the projected predictor increment δ, Rₙ, a work vector
   OwnedVec predictor_, static_residual_, work_;
-  OwnedVec previous_static_;                    ///< uₙ₋₁ of newton.predictor: extrapolate
+  OwnedVec warm_start_, predicted_;  ///< step(from_current): the last solve's state, the predictor
+  OwnedVec previous_static_;         ///< uₙ₋₁ of newton.predictor: extrapolate
   std::array<double, 2> static_factors_{0, 0};  ///< sₙ₋₁, sₙ of the converged static steps
   fem::P1Matrix matrix_;
   std::optional<fem::P1Matrix> mass_;  ///< inertia-density mass (dynamics only)
@@ -1843,8 +1864,9 @@ StepReport SolidModel::solve_static(double load_factor, run::RunOutput& output,
 void SolidModel::initialize_dynamics(run::RunOutput& output) {
   impl_->initialize_dynamics(output);
 }
-StepReport SolidModel::step(double time, double time_step, run::RunOutput& output) {
-  return impl_->step(time, time_step, output);
+StepReport SolidModel::step(double time, double time_step, run::RunOutput& output,
+                            bool from_current) {
+  return impl_->step(time, time_step, output, from_current);
 }
 void SolidModel::commit() {
   impl_->commit();

@@ -192,7 +192,11 @@ class SolidModel {
   void initialize_dynamics(run::RunOutput& output);
   /// One Newmark step of size Δt from the committed state into the trial state (time = the
   /// new time, for messages). Throws ConvergenceError with the history when Newton fails.
-  StepReport step(double time, double time_step, run::RunOutput& output);
+  /// `from_current`: Newton starts from the trial state the last call left (a coupling
+  /// iteration's previous solve of the same step, near this one's solution) when its residual
+  /// is below the predictor's; the tolerance stays relative to the predictor's residual, so the
+  /// start changes the path, not the accuracy.
+  StepReport step(double time, double time_step, run::RunOutput& output, bool from_current = false);
   /// The trial state becomes the committed state.
   void commit();
   /// The trial state is reset to the committed state.

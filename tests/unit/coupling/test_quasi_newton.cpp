@@ -1,7 +1,8 @@
 // IQN-ILS (coupling/quasi_newton.hpp) on affine fixed-point maps H(x) = A x + b, whose fixed
 // point x* = (I − A)⁻¹ b is known: IQN-ILS is then Newton's method on the span of its columns,
 // so it finds x* in at most n + 1 evaluations in R^n even where plain iteration diverges, and
-// with the columns of a past step reused it finds the fixed point of a new b at once.
+// with the columns of a past step reused it finds the fixed point of a new b at once (unless
+// they are dropped).
 #include <gtest/gtest.h>
 #include <mpi.h>
 
@@ -75,6 +76,35 @@ TEST(InterfaceQuasiNewton, ReusedColumnsSolveTheNextStepAtOnce) {
   const int evaluations = solve(accelerator, a, {0.3, 1, -1, 2, 0.5, -0.7}, x);
   EXPECT_LE(evaluations, 3);
   EXPECT_LT(residual_norm(a, {0.3, 1, -1, 2, 0.5, -0.7}, x), 1e-10);
+}
+
+TEST(InterfaceQuasiNewton, DroppedColumnsAreNotUsedAndForgottenAtTheStepsEnd) {
+  const auto a = matrix();
+  const std::vector<double> b = {1, -2, 0.5, 3, -1, 0.25};
+  InterfaceQuasiNewton accelerator(MPI_COMM_SELF, 2, 50, 1e-12);
+  std::vector<double> x(kSize, 0.0);
+  solve(accelerator, a, b, x);
+  accelerator.end_step();
+  ASSERT_EQ(accelerator.reused().size(), 1u);
+  const std::size_t first_columns = accelerator.reused().front().v.size();
+
+  // the next step uses the kept columns from its first update on ...
+  std::vector<double> x1(kSize, 0.0), next(kSize);
+  accelerator.begin_step();
+  EXPECT_EQ(accelerator.next(x1, apply(a, b, x1), 0.1, next), static_cast<int>(first_columns));
+  // ... and not once they are dropped: the relaxed update, then this step's columns alone
+  accelerator.begin_step();
+  accelerator.drop_reused();
+  EXPECT_TRUE(accelerator.reused_dropped());
+  EXPECT_EQ(accelerator.next(x1, apply(a, b, x1), 0.1, next), 0);
+  for (int i = 0; i < kSize; ++i) EXPECT_DOUBLE_EQ(next[i], 0.1 * b[i]);
+  x1 = next;
+  EXPECT_EQ(accelerator.next(x1, apply(a, b, x1), 0.1, next), 1);
+  // the step's end forgets the dropped steps and keeps this one's
+  accelerator.end_step();
+  ASSERT_EQ(accelerator.reused().size(), 1u);
+  EXPECT_EQ(accelerator.reused().front().v.size(), 1u);
+  EXPECT_FALSE(accelerator.reused_dropped());
 }
 
 TEST(InterfaceQuasiNewton, WithoutColumnsTheUpdateIsRelaxed) {
