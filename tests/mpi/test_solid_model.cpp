@@ -32,14 +32,18 @@ using coapt::solid::SolidModel;
 
 const MPI_Comm kWorld = MPI_COMM_WORLD;
 
-/// A clamped strip [0, 1] × [0, 0.1] of linear elastic material, static or Newmark.
-std::string strip_case(const std::string& extra) {
+/// A clamped strip [0, 1] × [0, 0.1] of linear elastic (or the given) material, static or
+/// Newmark.
+std::string strip_case(const std::string& extra,
+                       const std::string& material =
+                           "{model: linear_elastic, young_modulus: 1.0e6, poisson_ratio: 0.3}") {
   return R"(problem: solid
 mesh: {type: rectangle, lower: [0, 0], upper: [1, 0.1], cells: [10, 2]}
 bodies:
   - name: strip
     density: 1000
-    material: {model: linear_elastic, young_modulus: 1.0e6, poisson_ratio: 0.3}
+    material: )" +
+         material + R"(
 dirichlet:
   - boundary: left
 newton: {relative_tolerance: 1.0e-12}
@@ -185,20 +189,10 @@ TEST(SolidModel, StepFromTheLastIterateReachesTheSameStateInFewerIterations) {
   for (const bool stabilized : {false, true}) {
     SCOPED_TRACE(stabilized ? "contact_stabilized_newmark" : "newmark");
     Output output(stabilized ? "warm_start_csn" : "warm_start");
-    auto document = Document::from_string(R"(problem: solid
-mesh: {type: rectangle, lower: [0, 0], upper: [1, 0.1], cells: [10, 2]}
-bodies:
-  - name: strip
-    density: 1000
-    material: {model: neo_hookean, young_modulus: 1.0e5, poisson_ratio: 0.3}
-dirichlet:
-  - boundary: left
-newton: {relative_tolerance: 1.0e-10}
-output: {vtk: false}
-gravity: [0, -50]
-time: {scheme: newmark, step: 0.05, end_time: 1}
-)",
-                                          "warm.yaml");
+    auto document = Document::from_string(
+        strip_case("gravity: [0, -50]\ntime: {scheme: newmark, step: 0.05, end_time: 1}\n",
+                   "{model: neo_hookean, young_modulus: 1.0e5, poisson_ratio: 0.3}"),
+        "warm.yaml");
     SolidModel solid(document.root(), kWorld);
     solid.set_contact_stabilized(stabilized);
     solid.initialize_dynamics(output.output);
