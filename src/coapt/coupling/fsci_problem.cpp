@@ -71,6 +71,9 @@ struct CouplingSettings {
   /// transient: a deformable solid's Newton in a step's later iterations starts from its last
   /// iterate's state (SolidModel::step, from_current)
   bool solid_warm_start = false;
+  /// the relative tolerance's reference: the force the step starts from, ‖f⁰‖ (the paper's
+  /// ‖λ⁰‖; the first iterate's when it is zero), instead of the first iterate's ‖f¹‖
+  bool relative_to_start = false;
   int retries = 2;       ///< stronger relaxation, then (transient) halved steps
   int freeze_after = 0;  ///< keep the constrained sets from this iteration of a step on (0: never)
   double iteration_density = 0;  ///< transient: the solids' iteration inertia [kg/m³] (0: none)
@@ -253,6 +256,13 @@ Parameters read(const config::Section& root) {
        "this fraction, |A - A0| + |A0 - A| over |A or A0| (the past iterates were taken with "
        "another active set; 1: never)",
        Bounds::closed(0.0, 1.0)});
+  c.relative_to_start =
+      iteration.choice("relative_to", "first_iterate", {"first_iterate", "start"},
+                       {"",
+                        "the relative tolerance's reference: first_iterate (the force of "
+                        "the step's first coupling iteration) | start (the force the step "
+                        "starts from, the last step's: a first iterate far off cannot "
+                        "loosen the tolerance; the first iterate's when it is zero)"}) == "start";
   c.solid_warm_start = iteration.get<bool>(
       "solid_warm_start", false,
       {"",
@@ -1295,7 +1305,13 @@ class FsciProblem final : public run::Problem {
         force2 += weighted_square(*solid, solid->pressure_target);
       }
       const double norm = std::sqrt(norm2);
-      if (iteration == 1) first_norm = std::sqrt(force2);
+      if (iteration == 1) {
+        first_norm = std::sqrt(force2);
+        if (c.relative_to_start) {
+          const double start = start_norm();
+          if (start > 0) first_norm = start;
+        }
+      }
       report.history.push_back(norm);
       // One line per coupling iteration: a step of a large case can take many minutes. A
       // steady run has no per-step progress line, so there it is the progress (info).
@@ -1345,6 +1361,22 @@ class FsciProblem final : public run::Problem {
               quasi_newton_ ? fmt::format("IQN-ILS, {} column(s) in the last update", last_columns_)
                             : fmt::format("omega {:.3f}", fmt::join(report.relaxation, ", ")));
     return result;
+  }
+
+  /// ‖f⁰‖: the deformable solids' forces at the step's start (with coupling.pressure_in_solid
+  /// their weighted pressures too), the norm the iteration's change is measured against in
+  /// first_norm. Collective.
+  double start_norm() const {
+    double sum = 0;
+    for (const auto& solid : solids_) {
+      if (solid->model) {
+        double n = 0;
+        COAPT_PETSC_CHECK(VecNorm(solid->applied_start, NORM_2, &n));
+        sum += n * n;
+      }
+      if (solid->pressure) sum += weighted_square(*solid, solid->pressure_start);
+    }
+    return std::sqrt(sum);
   }
 
   /// How far the solids' contact active sets A moved from their committed A₀ (the step's
