@@ -19,8 +19,9 @@ swept_flow_past_contact + swept_flow_outside_fluid of series.csv (the last: the 
 inner sides' parts in the walls, where there is no fluid, not counted in S either). W sums the
 facets of the lower face (outward normal +y) whose reference nodes lie downstream of the most
 upstream active contact node at the step's end, and of the upper face (normal -y) whose
-deformed midpoint lies downstream of that node's deformed position. The solver cuts the upper face where the active nodes' multipliers cover
-half a node's support instead, so the two W may differ by about a facet's sweep.
+deformed midpoint lies downstream of that node's deformed position. The solver cuts the upper
+face where the active nodes' multipliers cover half a node's support instead, so the two W may
+differ by about a facet's sweep.
 
     /usr/bin/python3 cases/valve2d/wedge_sweep.py RUN_DIR
 """
