@@ -200,8 +200,9 @@ TEST(SolidModel, StepFromTheLastIterateReachesTheSameStateInFewerIterations) {
     VecSet(force, 0.0);
     solid.set_external_force(force);
     solid.step(0.05, 0.05, output.output);  // the first coupling iteration
-    // the next iterate's load: 0.5 % more weight, as a nodal force
-    VecSet(force, -0.005 * 50 * 1000 * 0.1 / 33);
+    // the next iterate's load: 0.5 % more weight (ρ g |strip|), spread over the 33 vertices
+    const double extra = -0.005 * 50 * 1000 * 0.1 / 33;
+    VecSet(force, extra);
     solid.restore();
     const auto cold = solid.step(0.05, 0.05, output.output);
     OwnedVec reference = coapt::fem::create_vertex_vector(solid.mesh(), 2);
@@ -213,7 +214,7 @@ TEST(SolidModel, StepFromTheLastIterateReachesTheSameStateInFewerIterations) {
     VecSet(force, 0.0);
     solid.restore();
     solid.step(0.05, 0.05, output.output);  // the first iterate again
-    VecSet(force, -0.005 * 50 * 1000 * 0.1 / 33);
+    VecSet(force, extra);
     const auto warm = solid.step(0.05, 0.05, output.output, true);
     EXPECT_LT(max_difference(reference, solid.displacement()), 1e-8 * scale);
     EXPECT_LT(warm.newton_iterations, cold.newton_iterations);

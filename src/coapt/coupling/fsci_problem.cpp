@@ -643,21 +643,22 @@ class FsciProblem final : public run::Problem {
     if (parameters_.pressure_in_solid && deformable_)
       log::info(
           "coupling: the deformable solids also carry the fluid's pressure over their region");
-    if (deformable_)
+    if (deformable_) {
+      std::string update;  // after the first iteration's relaxation
+      if (c.method == CouplingSettings::Method::aitken) update = " then Aitken";
+      if (c.method == CouplingSettings::Method::iqn_ils) {
+        update = fmt::format(" then IQN-ILS (reuse {} steps", c.reuse_steps);
+        if (c.contact_change < 1)
+          update += fmt::format(", not past an active-set change of {:g}", c.contact_change);
+        update += ")";
+      }
       log::info(
           "coupling: block Gauss-Seidel, |df| < {:g} or |df|/|f^{}| < {:g}, at most {} "
           "iterations, relaxation {:g}{}{}",
           c.absolute_tolerance, c.relative_to_start ? "0" : "1", c.relative_tolerance,
-          c.max_iterations, c.relaxation,
-          c.method == CouplingSettings::Method::aitken ? " then Aitken"
-          : c.method == CouplingSettings::Method::iqn_ils
-              ? fmt::format(
-                    " then IQN-ILS (reuse {} steps{})", c.reuse_steps,
-                    c.contact_change < 1
-                        ? fmt::format(", not past an active-set change of {:g}", c.contact_change)
-                        : std::string())
-              : std::string(),
+          c.max_iterations, c.relaxation, update,
           c.solid_warm_start ? "; the solids' Newton from the last iterate" : "");
+    }
   }
 
   /// Transient runs continue from a checkpoint of an earlier run (written every
