@@ -133,6 +133,11 @@ class SolidModelImpl {
                     ? fem::LinearSolverDefaults{"preonly", "lu", 1e-10, 1e-50, 2000}
                     : fem::LinearSolverDefaults{"gmres", "gamg", 1e-10, 1e-50, 2000}) {
     MPI_Comm_rank(comm_, &rank_);
+    if (parameters_.newton.reuse_factorisation > 0 && !parameters_.time.dynamic)
+      throw InputError(fmt::format(
+          "{}: only for a dynamic solid (time.scheme newmark or contact_stabilized_newmark, or "
+          "an immersed solid in a transient coupling)",
+          parameters_.newton.reuse_where));
     parameters_.check_dimension(dim_);
     assign_bodies();
     assign_fibres();
@@ -148,6 +153,14 @@ class SolidModelImpl {
       PC pc = nullptr;
       COAPT_PETSC_CHECK(KSPGetPC(solver_.ksp(), &pc));
       if (!given) COAPT_PETSC_CHECK(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+      // A kept factorisation is not exact for a later matrix: GMRES corrects it, where preonly
+      // (a contact solid's default, or -solid_ksp_type preonly) would turn Newton into a
+      // modified Newton.
+      PetscBool preonly = PETSC_FALSE;
+      COAPT_PETSC_CHECK(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(solver_.ksp()),
+                                               KSPPREONLY, &preonly));
+      if (parameters_.newton.reuse_factorisation > 0 && preonly)
+        COAPT_PETSC_CHECK(KSPSetType(solver_.ksp(), KSPGMRES));
     }
     if (dim_ == 2)
       assemble_external_load<2>();
@@ -184,9 +197,14 @@ class SolidModelImpl {
                 parameters_.time.n_steps, parameters_.time.step, parameters_.time.end_time);
     else
       log::info("{} load step(s)", parameters_.steps);
-    log::info("Newton: relative tolerance {:g}, absolute {:g}, update {:g}, at most {} its",
+    const int reuse = parameters_.newton.reuse_factorisation;
+    log::info("Newton: relative tolerance {:g}, absolute {:g}, update {:g}, at most {} its{}",
               parameters_.newton.relative_tolerance, parameters_.newton.absolute_tolerance,
-              parameters_.newton.update_tolerance, parameters_.newton.max_iterations);
+              parameters_.newton.update_tolerance, parameters_.newton.max_iterations,
+              reuse > 0 ? fmt::format("; a step's factorisation kept while GMRES on it takes at "
+                                      "most {} iterations",
+                                      reuse)
+                        : "");
     if (parameters_.mixed)
       log::info(
           "formulation: mixed P1-P1 displacement-pressure, Brezzi-Pitkaranta alpha = {:g}; "
@@ -349,6 +367,7 @@ class SolidModelImpl {
     Mat system = hook_ ? hook_->linear_system(u_.get(), matrix_.mat(), rhs) : matrix_.mat();
     {
       ScopedTimer timer(output.timers(), "solve");
+      factorisation_current_ = false;
       solver_.set_operator(system);
       COAPT_PETSC_CHECK(VecSet(update, 0.0));
       solver_.solve(rhs, update);
@@ -423,6 +442,7 @@ class SolidModelImpl {
       COAPT_PETSC_CHECK(VecCopy(residual_, rhs));
       COAPT_PETSC_CHECK(VecScale(rhs, -1.0));
       fem::apply_dirichlet(matrix_.mat(), rhs, dirichlet_dofs_, zero);
+      factorisation_current_ = false;
       solver_.set_operator(matrix_.mat());
       solver_.solve(rhs, a_);
       zero_dirichlet(a_);
@@ -505,6 +525,7 @@ class SolidModelImpl {
   }
 
   void commit() {
+    factorisation_current_ = false;  // newton.reuse_factorisation: within a time step only
     COAPT_PETSC_CHECK(VecCopy(u_, u_committed_));
     COAPT_PETSC_CHECK(VecCopy(v_, v_committed_));
     COAPT_PETSC_CHECK(VecCopy(a_, a_committed_));
@@ -526,6 +547,7 @@ class SolidModelImpl {
   }
 
   void restore() {
+    factorisation_current_ = false;
     COAPT_PETSC_CHECK(VecCopy(u_committed_, u_));
     COAPT_PETSC_CHECK(VecCopy(v_committed_, v_));
     COAPT_PETSC_CHECK(VecCopy(a_committed_, a_));
@@ -1649,12 +1671,12 @@ class SolidModelImpl {
         system = hook_ ? hook_->linear_system(u_.get(), matrix_.mat(), rhs) : matrix_.mat();
       }
       fem::SolveStats stats;
+      const int factorisations = report.factorisations;
       {
         ScopedTimer timer(output.timers(), "solve");
-        solver_.set_operator(system);
-        COAPT_PETSC_CHECK(VecSet(update, 0.0));
-        stats = solver_.solve(rhs, update);
+        stats = solve_newton_system(system, rhs, update, report);
       }
+      const bool kept = report.factorisations == factorisations;
       zero_dirichlet(update);
       report.linear_iterations += stats.iterations;
       double step_length = 1.0;
@@ -1691,14 +1713,40 @@ class SolidModelImpl {
       small_update = step_length * update_norm <= newton.update_tolerance * u_norm;
       const std::string line = fmt::format(
           "{}: newton {}  |R| = {:.6e}  (|R|/|R0| = {:.3e}, |du|/|u| = {:.3e}, step {:g}, {} "
-          "linear its)",
+          "linear its{})",
           where, report.newton_iterations, norm, norm / history.front(),
-          step_length * update_norm / u_norm, step_length, stats.iterations);
+          step_length * update_norm / u_norm, step_length, stats.iterations,
+          kept ? " on the kept factorisation" : "");
       if (verbose)
         log::info("{}", line);
       else
         log::debug("{}", line);
     }
+  }
+
+  /// One Newton system: on the step's kept factorisation when newton.reuse_factorisation
+  /// allows (GMRES capped at 4 N iterations; more than N, or a failure, and the next solve
+  /// factors afresh), else on a new one.
+  fem::SolveStats solve_newton_system(Mat system, Vec rhs, Vec update, StepReport& report) {
+    const int limit = parameters_.newton.reuse_factorisation;
+    if (limit > 0 && factorisation_current_) {
+      solver_.set_operator(system, true);
+      COAPT_PETSC_CHECK(VecSet(update, 0.0));
+      try {
+        const auto stats = solver_.solve(rhs, update, 4 * limit);
+        if (stats.iterations > limit) factorisation_current_ = false;
+        return stats;
+      } catch (const ConvergenceError& error) {
+        log::debug("solid: {} on the kept factorisation; factoring afresh", error.what());
+      }
+    }
+    factorisation_current_ = false;
+    solver_.set_operator(system);
+    COAPT_PETSC_CHECK(VecSet(update, 0.0));
+    ++report.factorisations;
+    const auto stats = solver_.solve(rhs, update);
+    factorisation_current_ = limit > 0;
+    return stats;
   }
 
   // --- output --------------------------------------------------------------------------------
@@ -1790,6 +1838,8 @@ class SolidModelImpl {
   std::optional<fem::P1Matrix> mass_;  ///< inertia-density mass (dynamics only)
   OwnedVec lumped_mass_;               ///< its diagonal (contact-stabilized predictor)
   fem::LinearSolver solver_;
+  /// newton.reuse_factorisation: solver_ holds a factorisation of this time step to reuse
+  bool factorisation_current_ = false;
   Vec extra_force_ = nullptr;        ///< not owned
   Vec immersed_pressure_ = nullptr;  ///< not owned: the fluid's pressure it carries [Pa]
   NewtonHook* hook_ = nullptr;       ///< not owned

@@ -102,6 +102,7 @@ struct BodyMotion {
 struct StepReport {
   int newton_iterations = 0;
   int linear_iterations = 0;    ///< summed over the Newton iterations
+  int factorisations = 0;       ///< new preconditioners (newton.reuse_factorisation: fewer)
   std::vector<double> history;  ///< ‖R‖ over the free dofs, one per iterate
   double norm() const { return history.empty() ? 0.0 : history.back(); }
 };

@@ -195,6 +195,15 @@ SolidParameters SolidParameters::read(const config::Section& root) {
   p.newton.max_iterations = newton.get<int>(
       "max_iterations", 25, {"", "iterations per load step", Bounds::closed(1, 1000)});
   p.newton.line_search = fem::read_line_search(newton);
+  p.newton.reuse_factorisation = newton.get<int>(
+      "reuse_factorisation", 0,
+      {"",
+       "dynamics: a time step's first factorisation preconditions GMRES (the solid's KSP "
+       "then) in the step's later Newton and coupling iterations until a solve on it needs "
+       "more than this many iterations; then it is factored afresh. 0: factored at every "
+       "Newton iteration",
+       Bounds::closed(0, 100)});
+  p.newton.reuse_where = newton.located("reuse_factorisation");
   p.newton.extrapolate =
       newton.choice("predictor", "previous", {"previous", "extrapolate"},
                     {"",

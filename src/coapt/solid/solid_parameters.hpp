@@ -124,6 +124,14 @@ struct NewtonParameters {
   /// ‖R‖ stays above the last iterate's, and the trial with the smallest ‖R‖ is kept (each
   /// trial re-evaluates R, contact terms and active set included).
   int line_search = 0;
+  /// `reuse_factorisation: N` (0: off; dynamics only): the factorisation of a time step's
+  /// first Newton solve preconditions GMRES in the step's later Newton iterations, coupling
+  /// iterations included, until a solve on it needs more than N iterations (or fails within
+  /// 4 N); then the matrix of that iteration is factored afresh. Each step starts with a new
+  /// factorisation, so a step's result does not depend on the steps before it (a restart
+  /// continues bit for bit).
+  int reuse_factorisation = 0;
+  std::string reuse_where;  ///< where the key is, for the error on a static solid
 };
 
 /// Time integration: `static` (load stepping, the default), `newmark` (β = 1/4, γ = 1/2) or
