@@ -126,10 +126,10 @@ struct NewtonParameters {
   int line_search = 0;
   /// `reuse_factorisation: N` (0: off; dynamics only): the factorisation of a time step's
   /// first Newton solve preconditions GMRES in the step's later Newton iterations, coupling
-  /// iterations included, until a solve on it needs more than N iterations (or fails within
-  /// 4 N); then the matrix of that iteration is factored afresh. Each step starts with a new
-  /// factorisation, so a step's result does not depend on the steps before it (a restart
-  /// continues bit for bit).
+  /// iterations included, until a solve on it needs more than N iterations (then the next
+  /// solve factors its matrix afresh) or fails within 4 N (then that solve does). Each step
+  /// starts with a new factorisation, so a step's result does not depend on the steps before
+  /// it (a restart continues bit for bit).
   int reuse_factorisation = 0;
   std::string reuse_where;  ///< where the key is, for the error on a static solid
 };
